@@ -1,0 +1,1 @@
+"""Subcommands of the ``odpipe`` command, one module each (discovered by :mod:`odpipe.cli`)."""

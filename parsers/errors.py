@@ -1,0 +1,53 @@
+"""The one exception every reader raises for malformed input."""
+
+from __future__ import annotations
+
+
+class ParseError(ValueError):
+    """Malformed input, located in the file.
+
+    Attributes: ``path`` (file name), ``offset`` (byte offset, binary formats),
+    ``line`` (1-based line number, text formats), ``record`` (record index or
+    keyword) and ``reason`` (what was wrong).
+    """
+
+    def __init__(self, path, reason, *, offset=None, line=None, record=None):
+        self.path = str(path)
+        self.reason = reason
+        self.offset = offset
+        self.line = line
+        self.record = record
+        where = [self.path]
+        if line is not None:
+            where.append(f"line {line}")
+        if offset is not None:
+            where.append(f"byte {offset}")
+        if record is not None:
+            where.append(f"record {record}")
+        super().__init__(f"{', '.join(where)}: {reason}")
+
+
+class ParseReport:
+    """What a reader in ``errors="report"`` mode skipped: a list of ParseError."""
+
+    def __init__(self):
+        self.errors: list[ParseError] = []
+
+    def add(self, err: ParseError) -> None:
+        self.errors.append(err)
+
+    def __len__(self) -> int:
+        return len(self.errors)
+
+    def __iter__(self):
+        return iter(self.errors)
+
+
+def handle(err: ParseError, errors: str, report: ParseReport | None) -> None:
+    """Raise ``err`` (errors="raise") or record it in ``report`` (errors="report")."""
+    if errors == "raise":
+        raise err
+    if errors != "report":
+        raise ValueError(f"errors must be 'raise' or 'report', not {errors!r}")
+    if report is not None:
+        report.add(err)

@@ -1,0 +1,80 @@
+"""The TrackingTable contract: the columns every tracking reader returns.
+
+One row per observable sample. Readers fill what their format carries and
+leave the rest at the column's missing value (NaN, "" or -1). Units are SI
+after the parser boundary (m, s, Hz, rad); the ``unit`` column names them,
+and observables a format gives in its own units (range units, cycles) keep
+that unit and say so.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+import pandas as pd
+
+# name -> (dtype, meaning)
+COLUMNS: dict[str, tuple[str, str]] = {
+    "epoch": ("datetime64[ns]", "UTC time tag as the format defines it"),
+    "tag": ("str", "meaning of the time tag: 'receive', 'transmit', 'interval_mid', 'interval_end', 'interval_start'"),
+    "observable": ("str", "range, doppler_1way, doppler_2way, doppler_3way, range_rate, angle_az, angle_el, angle_x, angle_y, "
+                          "phase_uplink, phase_downlink, sst_range, sst_doppler, dowr, tropo_dry, tropo_wet, stec, ..."),
+    "value": ("float64", "observed value in `unit`"),
+    "unit": ("str", "m, m/s, Hz, RU (range units), cycles, rad, s, TECU"),
+    "sigma": ("float64", "a priori 1-sigma in `unit` (NaN when the format gives none)"),
+    "count_time": ("float64", "s; Doppler count interval (0 for instantaneous samples)"),
+    "station_tx": ("str", "transmitting station, e.g. 'DSS-24' ('' for one-way)"),
+    "station_rx": ("str", "receiving station"),
+    "spacecraft": ("str", "spacecraft id as the format gives it, e.g. '181'"),
+    "band_up": ("str", "uplink band S/X/Ka ('' if none)"),
+    "band_down": ("str", "downlink band"),
+    "uplink_hz": ("float64", "Hz; reference uplink (or one-way reference) frequency at the tag, NaN when ramped"),
+    "ramped": ("bool", "True when the uplink follows a ramp table travelling beside the table"),
+    "transponder_ratio": ("float64", "turnaround ratio M2/M1 (e.g. 240/221); NaN for one-way"),
+    "source": ("str", "file the row was read from"),
+    "record": ("int64", "record index in the file (0-based)"),
+    "pass_id": ("int64", "pass number assigned by preprocessing (-1 before)"),
+    "flags": ("int64", "bitmask of edit reasons (see odpipe.preprocess.flags); 0 = used"),
+}
+
+
+def empty(extra: dict[str, str] | None = None) -> pd.DataFrame:
+    """An empty TrackingTable with the contract's dtypes (plus ``extra`` columns)."""
+    cols = {name: dt for name, (dt, _) in COLUMNS.items()}
+    cols.update(extra or {})
+    return pd.DataFrame({name: pd.Series(dtype=_pandas_dtype(dt)) for name, dt in cols.items()})
+
+
+def build(n: int, **columns) -> pd.DataFrame:
+    """A TrackingTable of ``n`` rows from arrays/scalars; unset columns get missing values.
+
+    Format-specific extra columns may be passed too; they are kept after the
+    contract's columns.
+    """
+    out = {}
+    for name, (dt, _) in COLUMNS.items():
+        if name in columns:
+            val = columns.pop(name)
+        else:
+            val = _missing(dt)
+        arr = np.broadcast_to(np.asarray(val), (n,)) if np.ndim(val) == 0 else np.asarray(val)
+        out[name] = pd.Series(arr, dtype=_pandas_dtype(dt)) if dt != "datetime64[ns]" else pd.Series(
+            np.asarray(arr, dtype="datetime64[ns]"))
+    for name, val in columns.items():
+        out[name] = np.broadcast_to(np.asarray(val), (n,)) if np.ndim(val) == 0 else np.asarray(val)
+    return pd.DataFrame(out)
+
+
+def validate(df: pd.DataFrame) -> None:
+    """Raise ValueError naming any contract column that is missing."""
+    missing = [c for c in COLUMNS if c not in df.columns]
+    if missing:
+        raise ValueError(f"not a TrackingTable: missing columns {missing}")
+
+
+def _missing(dt: str):
+    return {"float64": np.nan, "int64": -1, "str": "", "bool": False,
+            "datetime64[ns]": np.datetime64("NaT")}[dt]
+
+
+def _pandas_dtype(dt: str):
+    return object if dt == "str" else dt

@@ -1,0 +1,37 @@
+"""Shared test set-up: where the real data are, and the ``realdata`` marker's rule.
+
+Real data live in ``../shared/data`` beside the project (``ODPIPE_SHARED_DATA``
+overrides). Outside CI, tests marked ``realdata`` skip with a message when the
+folder is absent; under ``CI=true`` its absence is a failure.
+"""
+
+from __future__ import annotations
+
+import os
+from pathlib import Path
+
+import pytest
+
+ROOT = Path(__file__).resolve().parents[1]
+SHARED_DATA = Path(os.environ.get("ODPIPE_SHARED_DATA", ROOT.parent / "shared" / "data"))
+
+
+def _in_ci() -> bool:
+    return os.environ.get("CI", "").lower() in ("1", "true", "yes")
+
+
+def pytest_collection_modifyitems(config, items):
+    # Every realdata test goes through the shared_data fixture, which holds the rule.
+    for item in items:
+        if "realdata" in item.keywords:
+            item.add_marker(pytest.mark.usefixtures("shared_data"))
+
+
+@pytest.fixture(scope="session")
+def shared_data() -> Path:
+    """Path of ../shared/data; fails under CI when absent, skips otherwise."""
+    if not SHARED_DATA.is_dir():
+        if _in_ci():
+            pytest.fail(f"CI=true but the real data folder {SHARED_DATA} is absent")
+        pytest.skip(f"real data folder {SHARED_DATA} is absent")
+    return SHARED_DATA

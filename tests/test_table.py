@@ -1,0 +1,17 @@
+import numpy as np
+
+from parsers import ParseError, table
+
+
+def test_build_fills_missing_values():
+    df = table.build(2, epoch=np.array(["2012-04-08T00:00", "2012-04-08T00:01"], dtype="datetime64[ns]"),
+                     observable="doppler_2way", value=[1.0, 2.0])
+    table.validate(df)
+    assert df["station_tx"].tolist() == ["", ""]
+    assert df["record"].tolist() == [-1, -1]
+    assert np.isnan(df["sigma"]).all()
+
+
+def test_parse_error_names_the_place():
+    err = ParseError("x.odf", "bad data type 99", offset=2016, record=7)
+    assert str(err) == "x.odf, byte 2016, record 7: bad data type 99"
