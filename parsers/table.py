@@ -9,8 +9,12 @@ that unit and say so.
 
 from __future__ import annotations
 
+from dataclasses import dataclass, field
+
 import numpy as np
 import pandas as pd
+
+from parsers.errors import ParseReport
 
 # name -> (dtype, meaning)
 COLUMNS: dict[str, tuple[str, str]] = {
@@ -78,3 +82,31 @@ def _missing(dt: str):
 
 def _pandas_dtype(dt: str):
     return object if dt == "str" else dt
+
+
+# Ramp table: one row per uplink ramp segment, travelling beside a TrackingTable.
+RAMP_COLUMNS: dict[str, tuple[str, str]] = {
+    "station": ("str", "transmitting station, e.g. 'DSS-24'"),
+    "start": ("datetime64[ns]", "UTC start of the ramp segment"),
+    "end": ("datetime64[ns]", "UTC end of the segment (NaT when open-ended)"),
+    "freq_hz": ("float64", "Hz; sky-level uplink frequency at `start`"),
+    "rate_hz_s": ("float64", "Hz/s; linear ramp rate"),
+    "band": ("str", "uplink band S/X/Ka"),
+    "source": ("str", "file the ramp was read from"),
+    "record": ("int64", "record index in the file"),
+}
+
+
+@dataclass
+class TrackingData:
+    """What a tracking reader returns: the table, the ramps beside it, what was skipped, and header facts."""
+
+    table: pd.DataFrame
+    ramps: pd.DataFrame | None = None
+    report: ParseReport = field(default_factory=ParseReport)
+    meta: dict = field(default_factory=dict)
+
+
+def empty_ramps() -> pd.DataFrame:
+    """An empty ramp table with the contract's dtypes."""
+    return pd.DataFrame({n: pd.Series(dtype=_pandas_dtype(dt)) for n, (dt, _) in RAMP_COLUMNS.items()})
