@@ -1,0 +1,41 @@
+"""DSN TRK-2-34 (820-013, Tracking and Navigation Files, SFDU binary) reader and writer.
+
+``read(path)`` returns :class:`parsers.TrackingData`: the navigation observables as a
+TrackingTable (see :mod:`parsers.trk234.observables`), the uplink ramps (format 9) as a
+ramp table, and in ``meta["blocks"]`` every SFDU with all its fields (one
+:class:`Block` of packed records per format code), which :func:`write` turns back into the
+same bytes. :func:`new_block` makes SFDUs from scratch.
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+
+from parsers.errors import ParseReport
+from parsers.table import TrackingData
+from parsers.trk234 import layout
+from parsers.trk234.observables import ramp_table, tracking_table
+from parsers.trk234.sfdu import Block, split
+from parsers.trk234.writer import new_block, write
+
+__all__ = ["Block", "new_block", "read", "sniff", "write", "layout"]
+
+
+def sniff(head: bytes) -> bool:
+    """True when ``head`` starts with a TRK-2-34 SFDU label (NJPL2I00C123..C127)."""
+    return len(head) >= 12 and head[:4] == b"NJPL" and head[8:12] in {k.encode() for k in layout.SECONDARY}
+
+
+def read(path, errors: str = "raise") -> TrackingData:
+    """Read a TRK-2-34 file; ``errors="report"`` skips corrupt SFDUs into ``report``."""
+    path = Path(path)
+    report = ParseReport()
+    blocks = split(path.read_bytes(), path, errors, report)
+    counts = {b.format_code: 0 for b in blocks}
+    for b in blocks:
+        counts[b.format_code] += len(b.records)
+    spacecraft = sorted({int(s) for b in blocks for s in np.unique(b.records["scft_id"])})
+    meta = {"format": "TRK-2-34", "sfdu_counts": counts, "spacecraft": spacecraft, "blocks": blocks}
+    return TrackingData(tracking_table(blocks, path.name), ramp_table(blocks, path.name), report, meta)

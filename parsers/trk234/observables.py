@@ -1,0 +1,171 @@
+"""TRK-2-34 record blocks -> TrackingTable rows and the uplink ramp table.
+
+Rows per format code (``value`` in the format's own unit, named in ``unit``):
+
+- 0 uplink carrier phase: ``phase_uplink`` (cycles; hi*2^32 + lo + frac*2^-32), tag 'transmit'
+- 1 downlink carrier phase: ``phase_downlink`` (cycles; sample 0 at the time tag)
+- 2/3 sequential ranging phase: ``range_phase_uplink`` / ``range_phase_downlink`` (RU)
+- 4/5 PN ranging phase: ``pn_phase_uplink`` / ``pn_phase_downlink`` (RU)
+- 6 Doppler count: ``doppler_count_1way/2way/3way`` (cycles), by the Doppler mode
+- 7 sequential range and 14 PN range: ``range`` (RU)
+- 8 angles: ``angle_1`` and ``angle_2`` (rad; the SIS gives degrees; ``ang_type`` kept)
+- 11 DRVID: ``drvid`` (RU)
+- 16 carrier frequency observable: ``carrier_freq`` (Hz), one row per observation
+- 17 total count phase: ``total_phase`` (cycles), one row per observation
+
+Observation k of formats 16/17 is tagged at the SFDU time + k * obs_cnt_time. Formats
+9 (ramps) go to the ramp table; 10, 12, 13, 15 carry no navigation observable here and
+stay in the record blocks only. Every row keeps ``format_code`` and ``record`` (index of
+its SFDU in the file), so all of that SFDU's fields can be found in the blocks.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+import pandas as pd
+
+from parsers import table as tt
+from parsers.trk234 import layout
+from parsers.trk234.sfdu import Block
+
+_DEG = np.pi / 180.0
+
+
+def utc(year, doy, sec) -> np.ndarray:
+    """datetime64[ns] UTC from (year, day of year, seconds of day) arrays."""
+    jan1 = (np.asarray(year, np.int64) - 1970).astype("datetime64[Y]").astype("datetime64[D]")
+    ns = np.round(np.asarray(sec, np.float64) * 1e9).astype(np.int64).astype("timedelta64[ns]")
+    return jan1 + (np.asarray(doy, np.int64) - 1).astype("timedelta64[D]") + ns
+
+
+def phase_cycles(hi, lo, frac) -> np.ndarray:
+    """Cycles from the SIS's three unsigned words: hi * 2^32 + lo + frac * 2^-32."""
+    return (np.asarray(hi, np.float64) * 4294967296.0 + np.asarray(lo, np.float64)
+            + np.asarray(frac, np.float64) / 4294967296.0)
+
+
+def _dss(ids) -> np.ndarray:
+    ids = np.asarray(ids)
+    return np.where(ids > 0, np.char.add("DSS-", np.char.zfill(ids.astype(str), 2)), "").astype(object)
+
+
+def _band(codes) -> np.ndarray:
+    return np.array([layout.BANDS.get(int(c), "?") for c in range(256)], dtype=object)[np.asarray(codes)]
+
+
+_DOPPLER = {1: "1way", 2: "2way", 3: "3way"}
+
+
+def _common(r: np.ndarray, fc: int) -> dict:
+    """Columns every format shares: time tag, spacecraft, stations and bands from the secondary CHDO."""
+    names = r.dtype.names
+    cols = {"epoch": utc(r["year"], r["doy"], r["sec"]), "spacecraft": r["scft_id"].astype(str).astype(object)}
+    if "ul_dss_id" in names:
+        cols["station_tx"] = _dss(r["ul_dss_id"])
+    if "dl_dss_id" in names:
+        cols["station_rx"] = _dss(r["dl_dss_id"])
+        if "ul_prdx_stn" in names:
+            mode = r["prdx_mode"]
+            cols["station_tx"] = np.where(mode == 2, cols["station_rx"],
+                                          np.where(mode == 3, _dss(r["ul_prdx_stn"]), "")).astype(object)
+    if "ul_band" in names:
+        cols["band_up"] = _band(r["ul_band"])
+    if "vld_dl_band" in names:
+        cols["band_down"] = _band(r["vld_dl_band"])
+    elif "dl_band" in names:
+        cols["band_down"] = _band(r["dl_band"])
+    if "scft_transpd_turn_den" in names:
+        den = r["scft_transpd_turn_den"].astype(np.float64)
+        cols["transponder_ratio"] = np.where(den > 0, r["scft_transpd_turn_num"] / np.where(den > 0, den, 1),
+                                             np.nan)
+    if "cnt_time" in names:
+        cols["count_time"] = r["cnt_time"].astype(np.float64)
+    cols["tag"] = "transmit" if layout.CLASS_OF_FORMAT[fc] == "C123" else "receive"
+    cols["format_code"] = np.int64(fc)
+    return cols
+
+
+def _rows(block: Block) -> list[dict]:
+    """Column dicts (one per observable kind) of one block."""
+    r, fc = block.records, block.format_code
+    base = _common(r, fc)
+    base["record"] = block.index
+    one = {
+        0: ("phase_uplink", lambda: phase_cycles(r["ul_hi_phs_cycles"], r["ul_lo_phs_cycles"],
+                                                 r["ul_frac_phs_cycles"]), "cycles"),
+        1: ("phase_downlink", lambda: phase_cycles(r["phs_hi_0"], r["phs_lo_0"], r["phs_frac_0"]), "cycles"),
+        2: ("range_phase_uplink", lambda: r["ul_rng_phs"], "RU"),
+        3: ("range_phase_downlink", lambda: r["dl_rng_phs"], "RU"),
+        4: ("pn_phase_uplink", lambda: r["ul_rng_phs"], "RU"),
+        5: ("pn_phase_downlink", lambda: r["dl_rng_phs"], "RU"),
+        7: ("range", lambda: r["rng_obs"], "RU"),
+        11: ("drvid", lambda: r["drvid"], "RU"),
+        14: ("range", lambda: r["rng_obs_dl"], "RU"),
+    }
+    if fc in one:
+        name, value, unit = one[fc]
+        extra = {}
+        if fc == 0:
+            extra["uplink_hz"] = r["ramp_freq"]
+        if fc in (7, 14):
+            extra["range_modulus"] = r["rng_modulo"].astype(np.float64)
+            extra["uplink_hz"] = r["ul_freq"] if fc == 7 else np.nan
+        return [dict(base, observable=name, value=np.asarray(value(), np.float64), unit=unit, **extra)]
+    if fc == 6:
+        mode = np.array([_DOPPLER.get(int(m), "unknown") for m in range(256)], dtype=object)[r["prdx_mode"]]
+        return [dict(base, observable=np.char.add("doppler_count_", mode.astype(str)).astype(object),
+                     value=r["dop_cnt"].astype(np.float64), unit="cycles", uplink_hz=r["ul_freq"],
+                     doppler_bias_hz=r["dop_cnt_bias_freq"])]
+    if fc == 8:
+        return [dict(base, observable=f"angle_{k}", value=r[f"ang{k}"].astype(np.float64) * _DEG, unit="rad",
+                     angle_type=r["ang_type"].astype(np.int64)) for k in (1, 2)]
+    if fc in (16, 17):
+        n = block.n_obs
+        if n == 0:
+            return []
+        obs = r["obs"]
+        step = (np.arange(n) * r["obs_cnt_time"].astype(np.float64)[:, None] * 1e9).round().astype("timedelta64[ns]")
+        rep = {k: np.repeat(np.asarray(v), n) if np.ndim(v) else v for k, v in base.items()}
+        rep["epoch"] = (base["epoch"][:, None] + step).ravel()
+        rep["count_time"] = np.repeat(r["obs_cnt_time"].astype(np.float64), n)
+        rep["sample"] = np.tile(np.arange(n), len(r))
+        if fc == 16:
+            return [dict(rep, observable="carrier_freq", value=obs["rcv_carr_obs"].ravel(), unit="Hz")]
+        value = phase_cycles(obs["total_cnt_phs_obs_hi"], obs["total_cnt_phs_obs_lo"], obs["total_cnt_phs_obs_frac"])
+        return [dict(rep, observable="total_phase", value=value.ravel(), unit="cycles")]
+    return []
+
+
+def tracking_table(blocks: list[Block], source: str) -> pd.DataFrame:
+    """The TrackingTable of all navigation observables in ``blocks``, time ordered."""
+    parts = []
+    for block in blocks:
+        for cols in _rows(block):
+            n = len(cols["record"])
+            parts.append(tt.build(n, source=source, flags=0, **cols))
+    if not parts:
+        return tt.empty({"format_code": "int64"})
+    df = pd.concat(parts, ignore_index=True)
+    return df.sort_values(["epoch", "record"], kind="stable").reset_index(drop=True)
+
+
+def ramp_table(blocks: list[Block], source: str) -> pd.DataFrame:
+    """Uplink ramps (format 9) per RAMP_COLUMNS; a segment ends where the station's next one starts."""
+    ramps = [b for b in blocks if b.format_code == 9]
+    if not ramps:
+        return tt.empty_ramps()
+    r = np.concatenate([b.records for b in ramps])
+    index = np.concatenate([b.index for b in ramps])
+    df = pd.DataFrame({
+        "station": _dss(r["ul_dss_id"]),
+        "start": utc(r["year"], r["doy"], r["sec"]),
+        "end": np.datetime64("NaT", "ns"),
+        "freq_hz": r["ramp_freq"].astype(np.float64),
+        "rate_hz_s": r["ramp_rate"].astype(np.float64),
+        "band": _band(r["ul_band"]),
+        "source": source,
+        "record": index.astype(np.int64),
+        "ramp_type": r["ramp_type"].astype(np.int64),
+    }).sort_values(["station", "start", "record"], kind="stable")
+    df["end"] = df.groupby("station")["start"].shift(-1)
+    return df.sort_values(["start", "record"], kind="stable").reset_index(drop=True)
