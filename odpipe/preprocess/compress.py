@@ -1,0 +1,237 @@
+"""Doppler compression to a longer count time, exact for both kinds of Doppler data.
+
+* Count-averaged Doppler (``doppler_*``, ``range_rate``, ``sst_doppler`` with a
+  count time): N back-to-back count intervals average, weighted by their count
+  times, to exactly the count-averaged Doppler over their union.
+* Accumulated phase (``phase_*`` in cycles, e.g. TRK-2-34 total count phase or
+  UTDF Doppler counters): the difference of phase at the ends of a window over
+  its length is exactly the mean frequency (Hz) over it; the row becomes
+  ``<observable>_rate`` tagged at the middle of the interval.
+
+Windows never span a gap, an overlap, a pass, an uplink ramp segment or a source
+file. Each segment's windows start at its first sample, so only a segment's last
+window can be short; ``partial`` says what becomes of it. Edited rows
+(``flags != 0``) and other observables pass through unchanged. Every output row
+says which raw records went into it (``source_records``, ``record_first``,
+``record_last``, ``n_samples``).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+import numpy as np
+import pandas as pd
+
+from odpipe.preprocess import ramp_segments
+from odpipe.preprocess.flags import Flag
+from odpipe.preprocess.noise import third_difference_scatter
+from odpipe.preprocess.passes import assign_passes
+from odpipe.preprocess.timetags import interval_bounds, tag_epoch
+from parsers.table import COLUMNS
+
+AVERAGED = ("range_rate", "sst_doppler")
+NEW_COLUMNS = ["n_samples", "record_first", "record_last", "source_records", "scatter"]
+
+
+@dataclass
+class CompressionReport:
+    """What compression did: raw rows in, rows out by kind, and raw records not represented."""
+
+    raw_rows: int = 0
+    averaged_rows: int = 0
+    phase_rows: int = 0
+    passthrough_rows: int = 0
+    partial_rows: int = 0
+    dropped: pd.DataFrame = field(default_factory=lambda: pd.DataFrame(columns=["source", "record", "reason"]))
+
+    def lines(self) -> list[str]:
+        """Human-readable summary."""
+        return [f"raw rows: {self.raw_rows}",
+                f"compressed count-averaged rows: {self.averaged_rows}",
+                f"phase-differenced rows: {self.phase_rows}",
+                f"passed through unchanged: {self.passthrough_rows}",
+                f"partial (short) windows: {self.partial_rows}",
+                f"raw records not represented: {len(self.dropped)}"]
+
+
+def _is_averaged(df: pd.DataFrame) -> np.ndarray:
+    obs = df["observable"].astype(str)
+    return ((obs.str.startswith("doppler") | obs.isin(AVERAGED)).to_numpy()
+            & (df["count_time"].to_numpy(dtype=float) > 0) & (df["flags"].to_numpy() == 0))
+
+
+def _is_phase(df: pd.DataFrame) -> np.ndarray:
+    return (df["observable"].astype(str).str.startswith("phase").to_numpy()
+            & (df["unit"].to_numpy() == "cycles") & (df["flags"].to_numpy() == 0))
+
+
+def _segments(df: pd.DataFrame, start, end, ramps, tol_ns, contiguous: bool):
+    """Sort order and segment id (sorted) of runs that windows may not cross."""
+    ramp = ramp_segments.segment_index(df["station_tx"].to_numpy(), df["ramped"].to_numpy(), start, ramps)
+    src = pd.factorize(df["source"])[0]
+    order = np.lexsort((start, ramp, src, df["pass_id"].to_numpy()))
+    brk = np.zeros(len(df), dtype=bool)
+    brk[0] = True
+    for key in (df["pass_id"].to_numpy(), src, ramp):
+        k = key[order]
+        brk[1:] |= k[1:] != k[:-1]
+    if contiguous:
+        brk[1:] |= np.abs(start[order][1:] - end[order][:-1]) > tol_ns
+    return order, np.cumsum(brk) - 1
+
+
+def _group_records(records: np.ndarray, group: np.ndarray, n_groups: int) -> list:
+    cuts = np.flatnonzero(np.diff(group)) + 1
+    return np.split(records, cuts) if n_groups else []
+
+
+def _extra_means(sub: pd.DataFrame, group: np.ndarray, weights: np.ndarray, n_groups: int) -> dict:
+    """Count-time-weighted means of format-specific numeric columns (others keep the first value)."""
+    out = {}
+    for col in sub.columns:
+        if col in COLUMNS or col in NEW_COLUMNS or sub[col].dtype.kind not in "fiu":
+            continue
+        x = sub[col].to_numpy(dtype=float)
+        out[col] = np.bincount(group, weights=x * weights, minlength=n_groups) / np.bincount(
+            group, weights=weights, minlength=n_groups)
+    return out
+
+
+def _compress_averaged(df, ramps, count_ns, tol_ns):
+    epoch = df["epoch"].to_numpy().astype("datetime64[ns]").view(np.int64)
+    start, end = interval_bounds(epoch, df["count_time"].to_numpy(), df["tag"].to_numpy())
+    order, seg = _segments(df, start, end, ramps, tol_ns, contiguous=True)
+    sub = df.iloc[order].reset_index(drop=True)
+    s, e = start[order], end[order]
+    first_of_seg = np.r_[0, np.flatnonzero(np.diff(seg)) + 1]
+    seg_start = s[first_of_seg][seg]
+    window = (s - seg_start + tol_ns) // count_ns
+    newgrp = np.r_[True, (seg[1:] != seg[:-1]) | (window[1:] != window[:-1])]
+    grp = np.cumsum(newgrp) - 1
+    ng = int(grp[-1]) + 1
+    first = np.flatnonzero(newgrp)
+    last = np.r_[first[1:] - 1, len(sub) - 1]
+    ct = sub["count_time"].to_numpy(dtype=float)
+    v = sub["value"].to_numpy(dtype=float)
+    ref = v[first][grp]  # subtract each window's first value: sums stay precise
+    total_ct = np.bincount(grp, weights=ct, minlength=ng)
+    value = v[first] + np.bincount(grp, weights=(v - ref) * ct, minlength=ng) / total_ct
+    scatter, _ = third_difference_scatter(v, grp, ng)
+    ratio = np.sqrt(ct[first] / total_ct)
+    sigma = np.where(np.isfinite(scatter), scatter, sub["sigma"].to_numpy(dtype=float)[first]) * ratio
+    out = sub.iloc[first].reset_index(drop=True)
+    out["epoch"] = tag_epoch(s[first], e[last], out["tag"].to_numpy()).view("datetime64[ns]")
+    out["value"] = value
+    out["sigma"] = sigma
+    out["count_time"] = (e[last] - s[first]) / 1e9
+    records = sub["record"].to_numpy()
+    out["record_first"] = records[first]
+    out["record_last"] = records[last]
+    out["n_samples"] = np.bincount(grp, minlength=ng)
+    out["source_records"] = _group_records(records, grp, ng)
+    out["scatter"] = scatter
+    for col, mean in _extra_means(sub, grp, ct, ng).items():
+        out[col] = mean
+    return out
+
+
+def _compress_phase(df, ramps, count_ns, tol_ns):
+    t = df["epoch"].to_numpy().astype("datetime64[ns]").view(np.int64)
+    order, seg = _segments(df, t, t, ramps, tol_ns, contiguous=False)
+    sub = df.iloc[order].reset_index(drop=True)
+    t = t[order]
+    phase = sub["value"].to_numpy(dtype=float)
+    first_of_seg = np.r_[0, np.flatnonzero(np.diff(seg)) + 1]
+    last_of_seg = np.r_[first_of_seg[1:] - 1, len(sub) - 1]
+    rel = (t - t[first_of_seg][seg]) % count_ns
+    node = (rel <= tol_ns) | (rel >= count_ns - tol_ns)
+    node[last_of_seg] = True
+    nodes = np.flatnonzero(node)
+    a, b = nodes[:-1], nodes[1:]
+    keep = seg[a] == seg[b]
+    a, b = a[keep], b[keep]
+    span_s = (t[b] - t[a]) / 1e9
+    # samples a..b belong to window j; label each sample by the window that starts at or before it
+    win = np.full(len(sub), -1)
+    win[a] = np.arange(len(a))
+    win = np.maximum.accumulate(win)
+    scatter, _ = third_difference_scatter(phase, np.where(win >= 0, win, len(a)), len(a) + 1)
+    scatter = scatter[:-1]
+    sig_phase = np.where(np.isfinite(scatter), scatter, sub["sigma"].to_numpy(dtype=float)[a])
+    out = sub.iloc[a].reset_index(drop=True)
+    out["epoch"] = ((t[a] + t[b]) // 2).view("datetime64[ns]")
+    out["tag"] = "interval_mid"
+    out["observable"] = out["observable"] + "_rate"
+    out["unit"] = "Hz"
+    out["value"] = (phase[b] - phase[a]) / span_s
+    out["sigma"] = np.sqrt(2.0) * sig_phase / span_s
+    out["count_time"] = span_s
+    records = sub["record"].to_numpy()
+    out["record_first"] = records[a]
+    out["record_last"] = records[b]
+    out["n_samples"] = b - a + 1
+    out["source_records"] = [records[i:j + 1] for i, j in zip(a, b)]
+    out["scatter"] = scatter * np.sqrt(2.0) / span_s
+    covered = (win >= 0) & (np.arange(len(sub)) <= np.append(b, -1)[win])
+    unused = sub.loc[~covered, ["source", "record"]].assign(reason="phase sample without a partner")
+    return out, unused
+
+
+def _passthrough(df):
+    out = df.copy()
+    rec = out["record"].to_numpy()
+    out["n_samples"] = 1
+    out["record_first"] = rec
+    out["record_last"] = rec
+    out["source_records"] = [rec[i:i + 1] for i in range(len(rec))]
+    out["scatter"] = np.nan
+    return out
+
+
+def compress(table: pd.DataFrame, count_time: float = 60.0, *, ramps: pd.DataFrame | None = None,
+             partial: str = "keep", tol: float = 1e-4, max_gap: float = 600.0):
+    """Compress Doppler in ``table`` to ``count_time`` (s); returns (table, CompressionReport).
+
+    ``partial``: a window shorter than ``count_time`` by more than ``tol`` (s) is
+    kept as a shorter count ("keep"), kept with the PARTIAL_COUNT flag ("flag"),
+    or left out and its raw records listed in the report ("drop"). Passes are
+    assigned first (``max_gap``, s) when ``pass_id`` is unset. Sigma of a
+    compressed row is the per-sample scatter (third differences, or the a priori
+    sigma when a window has under 4 samples) times sqrt(raw count / new count).
+    """
+    if partial not in ("keep", "flag", "drop"):
+        raise ValueError(f"partial must be keep, flag or drop, not {partial!r}")
+    if (table["pass_id"] < 0).any():
+        table = assign_passes(table, ramps, max_gap=max_gap)
+    count_ns, tol_ns = int(round(count_time * 1e9)), int(round(tol * 1e9))
+    avg, pha = _is_averaged(table), _is_phase(table)
+    report = CompressionReport(raw_rows=len(table))
+    parts, dropped = [], []
+    if avg.any():
+        parts.append(_compress_averaged(table[avg], ramps, count_ns, tol_ns))
+        report.averaged_rows = len(parts[-1])
+    if pha.any():
+        rows, unused = _compress_phase(table[pha], ramps, count_ns, tol_ns)
+        parts.append(rows)
+        dropped.append(unused)
+        report.phase_rows = len(rows)
+    compressed = pd.concat(parts, ignore_index=True) if parts else None
+    if compressed is not None:
+        short = compressed["count_time"].to_numpy() < count_time - tol
+        report.partial_rows = int(short.sum())
+        if partial == "flag":
+            compressed.loc[short, "flags"] = compressed.loc[short, "flags"] | int(Flag.PARTIAL_COUNT)
+        elif partial == "drop":
+            gone = compressed[short]
+            dropped.append(pd.DataFrame({"source": np.repeat(gone["source"].to_numpy(), gone["n_samples"]),
+                                         "record": np.concatenate(list(gone["source_records"])) if len(gone) else [],
+                                         "reason": "partial window"}))
+            compressed = compressed[~short]
+    rest = _passthrough(table[~(avg | pha)])
+    report.passthrough_rows = len(rest)
+    out = pd.concat([p for p in (compressed, rest) if p is not None], ignore_index=True)
+    out = out.sort_values(["epoch", "pass_id"], kind="stable").reset_index(drop=True)
+    if dropped:
+        report.dropped = pd.concat(dropped, ignore_index=True)
+    return out, report

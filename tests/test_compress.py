@@ -1,0 +1,170 @@
+"""Doppler compression against analytic truth: exact averages, sqrt(N) noise, and edge cases."""
+
+import numpy as np
+import pandas as pd
+import pytest
+
+from odpipe.preprocess.compress import compress
+from odpipe.preprocess.flags import Flag
+from parsers.table import build, empty_ramps
+
+T0 = np.datetime64("2012-04-09T00:00:00", "ns")
+A, B, C, W = 2.1e6, -3.5, 40.0, 2 * np.pi / 7000.0  # Hz, Hz/s, Hz, rad/s
+
+
+def truth_integral(t):
+    """Antiderivative (cycles) of the true Doppler f(t) = A + B t + C sin(W t), t in s."""
+    return A * t + 0.5 * B * t * t - C / W * np.cos(W * t)
+
+
+def doppler_table(t_mid, count=1.0, noise=None, tag="interval_mid", **kw):
+    """1-s count-averaged Doppler, values the exact mean of f over each count interval."""
+    t_mid = np.asarray(t_mid, dtype=float)
+    v = (truth_integral(t_mid + count / 2) - truth_integral(t_mid - count / 2)) / count
+    if noise is not None:
+        v = v + noise
+    shift = {"interval_mid": 0.0, "interval_end": count / 2, "interval_start": -count / 2}[tag]
+    epoch = T0 + np.rint((t_mid + shift) * 1e9).astype("timedelta64[ns]")
+    cols = dict(epoch=epoch, tag=tag, observable="doppler_2way", value=v, unit="Hz", sigma=0.01,
+                count_time=count, station_tx="DSS-24", station_rx="DSS-24", spacecraft="181",
+                band_up="S", band_down="S", ramped=False, uplink_hz=2.1e9, source="synthetic",
+                record=np.arange(len(t_mid)), flags=0)
+    cols.update(kw)
+    return build(len(t_mid), **cols)
+
+
+def window_truth(out):
+    """Exact mean of f over each output row's interval (mid-tagged rows)."""
+    mid = (out["epoch"] - T0).dt.total_seconds().to_numpy()
+    ct = out["count_time"].to_numpy()
+    return (truth_integral(mid + ct / 2) - truth_integral(mid - ct / 2)) / ct
+
+
+def test_compression_reproduces_the_exact_average_over_the_new_count():
+    tab = doppler_table(np.arange(0.5, 3600.0, 1.0))  # intervals [0,1), [1,2), ... back to back
+    out, rep = compress(tab, 60.0)
+    assert len(out) == 60 and rep.averaged_rows == 60 and rep.partial_rows == 0
+    assert np.allclose(out["count_time"], 60.0)
+    assert np.all(out["n_samples"] == 60)
+    # first window spans [0, 60) s: mid tag at 30 s
+    assert out["epoch"].iloc[0] == T0 + np.timedelta64(30, "s")
+    err = out["value"].to_numpy() - window_truth(out)
+    assert np.max(np.abs(err)) < 1e-7  # Hz, on values of 2e6 Hz
+
+
+@pytest.mark.parametrize("tag,offset_s", [("interval_end", 60.0), ("interval_start", 0.0)])
+def test_time_tag_convention_is_kept(tag, offset_s):
+    tab = doppler_table(np.arange(0.5, 600.0, 1.0), tag=tag)
+    out, _ = compress(tab, 60.0)
+    assert (out["tag"] == tag).all()
+    assert out["epoch"].iloc[0] == T0 + np.timedelta64(int(offset_s), "s")
+    mid = (out["epoch"] - T0).dt.total_seconds().to_numpy() + {"interval_end": -30, "interval_start": 30}[tag]
+    exact = (truth_integral(mid + 30) - truth_integral(mid - 30)) / 60
+    assert np.max(np.abs(out["value"].to_numpy() - exact)) < 1e-7
+
+
+def test_white_noise_scatter_falls_by_sqrt_n():
+    rng = np.random.default_rng(1)
+    n = 60 * 2000
+    sigma = 0.05
+    noise = rng.normal(0.0, sigma, n)
+    tab = doppler_table(np.arange(n) + 0.5, noise=noise)
+    out, _ = compress(tab, 60.0)
+    resid = out["value"].to_numpy() - window_truth(out)
+    ratio = np.std(tab["value"].to_numpy() - doppler_table(np.arange(n) + 0.5)["value"].to_numpy()) / np.std(resid)
+    assert ratio == pytest.approx(np.sqrt(60), rel=0.05)
+    # the new sigma, estimated from each window's scatter, matches sigma/sqrt(60) on average
+    assert np.median(out["sigma"]) == pytest.approx(sigma / np.sqrt(60), rel=0.05)
+    assert np.median(out["scatter"]) == pytest.approx(sigma, rel=0.05)
+
+
+def test_gap_inside_a_window_splits_it():
+    t = np.arange(0.5, 300.0, 1.0)
+    t = t[(t < 100) | (t > 105)]  # intervals [100, 105) missing, inside the window [60, 120)
+    out, rep = compress(doppler_table(t), 60.0, partial="keep")
+    # every compressed row is one contiguous run: its count time equals its sample count
+    assert np.allclose(out["count_time"], out["n_samples"] * 1.0)
+    assert out["n_samples"].sum() == len(t)
+    assert np.max(np.abs(out["value"].to_numpy() - window_truth(out))) < 1e-7
+    # the run before the hole ends at 100 s, the one after starts at 105 s
+    starts = (out["epoch"] - T0).dt.total_seconds() - out["count_time"] / 2
+    ends = starts + out["count_time"]
+    assert 100.0 in set(np.round(ends, 6)) and 105.0 in set(np.round(starts, 6))
+    assert not ((starts < 100) & (ends > 100)).any()
+
+
+def test_ramp_change_is_never_crossed():
+    t = np.arange(0.5, 600.0, 1.0)
+    tab = doppler_table(t, ramped=True, uplink_hz=np.nan)
+    ramps = pd.concat([empty_ramps(), pd.DataFrame({
+        "station": ["DSS-24", "DSS-24"], "start": [T0, T0 + np.timedelta64(90, "s")], "end": [pd.NaT, pd.NaT],
+        "freq_hz": [2.1e9, 2.1e9 + 90 * 5.0], "rate_hz_s": [5.0, -2.0], "band": "S",
+        "source": "synthetic", "record": [0, 1]})], ignore_index=True)
+    out, _ = compress(tab, 60.0, ramps=ramps)
+    starts = (out["epoch"] - T0).dt.total_seconds() - out["count_time"] / 2
+    ends = starts + out["count_time"]
+    assert not ((starts < 90) & (ends > 90)).any()
+    assert 90.0 in set(np.round(ends, 6)) and 90.0 in set(np.round(starts, 6))
+    # a continuous ramp (rate change only) does not split the pass
+    assert out["pass_id"].nunique() == 1
+
+
+@pytest.mark.parametrize("partial", ["keep", "flag", "drop"])
+def test_pass_shorter_than_the_count_time(partial):
+    out, rep = compress(doppler_table(np.arange(0.5, 20.0, 1.0)), 60.0, partial=partial)
+    assert rep.partial_rows == 1
+    if partial == "drop":
+        assert len(out) == 0
+        assert sorted(rep.dropped["record"]) == list(range(20))
+        return
+    assert len(out) == 1 and out["count_time"].iloc[0] == 20.0 and out["n_samples"].iloc[0] == 20
+    assert (out["flags"].iloc[0] & Flag.PARTIAL_COUNT) == (Flag.PARTIAL_COUNT if partial == "flag" else 0)
+    assert out["value"].iloc[0] == pytest.approx(window_truth(out)[0], abs=1e-7)
+
+
+def test_unsorted_input_gives_the_same_result():
+    tab = doppler_table(np.arange(0.5, 1800.0, 1.0))
+    shuffled = tab.sample(frac=1.0, random_state=3).reset_index(drop=True)
+    a, _ = compress(tab, 60.0)
+    b, _ = compress(shuffled, 60.0)
+    assert np.array_equal(a["value"].to_numpy(), b["value"].to_numpy())
+    assert [list(r) for r in a["source_records"]] == [list(r) for r in b["source_records"]]
+
+
+def test_flagged_rows_pass_through_and_break_contiguity():
+    tab = doppler_table(np.arange(0.5, 120.0, 1.0))
+    tab.loc[30, "flags"] = int(Flag.BLUNDER)
+    tab.loc[30, "value"] = 1e8
+    out, rep = compress(tab, 60.0)
+    assert rep.passthrough_rows == 1
+    flagged = out[out["flags"] != 0]
+    assert len(flagged) == 1 and flagged["value"].iloc[0] == 1e8
+    good = out[out["flags"] == 0]
+    assert np.max(np.abs(good["value"].to_numpy() - window_truth(good))) < 1e-7
+    assert out["n_samples"].sum() == len(tab)
+
+
+def test_accumulated_phase_is_differenced_exactly():
+    t = np.arange(0.0, 601.0, 1.0)  # 601 phase samples span 600 s
+    phase = truth_integral(t) - truth_integral(0.0)
+    tab = build(len(t), epoch=T0 + (t * 1e9).astype("timedelta64[ns]"), tag="receive",
+                observable="phase_downlink", value=phase, unit="cycles", sigma=1e-3, count_time=0.0,
+                station_rx="DSS-24", spacecraft="181", band_down="X", source="synthetic",
+                record=np.arange(len(t)), flags=0)
+    out, rep = compress(tab, 60.0)
+    assert rep.phase_rows == 10 and len(rep.dropped) == 0
+    assert (out["observable"] == "phase_downlink_rate").all() and (out["unit"] == "Hz").all()
+    assert np.allclose(out["count_time"], 60.0)
+    assert np.max(np.abs(out["value"].to_numpy() - window_truth(out))) < 1e-6
+    assert list(out["source_records"].iloc[1]) == list(range(60, 121))
+
+
+def test_other_observables_pass_through():
+    dop = doppler_table(np.arange(0.5, 120.0, 1.0))
+    rng = build(3, epoch=T0 + np.array([10, 20, 30], dtype="timedelta64[s]"), tag="receive",
+                observable="range", value=[1.0, 2.0, 3.0], unit="RU", count_time=0.0, source="synthetic",
+                record=[500, 501, 502], flags=0)
+    out, rep = compress(pd.concat([dop, rng], ignore_index=True), 60.0)
+    assert rep.passthrough_rows == 3 and rep.averaged_rows == 2
+    assert out["epoch"].is_monotonic_increasing
+    assert list(out.loc[out["observable"] == "range", "value"]) == [1.0, 2.0, 3.0]
