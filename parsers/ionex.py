@@ -1,0 +1,202 @@
+"""IONEX 1.0/1.1 ionosphere maps (Schaer, Gurtner & Feltens 1998).
+
+``read_ionex(*paths)`` returns one :class:`IonexMaps` holding every TEC map of
+the files (maps at the same epoch in several files must agree; e.g. the
+split-1/2/3 files of one day combine to the day's file). Values are scaled by
+each block's EXPONENT (which may change between and inside maps) and given in
+TECU (1e16 el/m^2); missing values (9999) are NaN. Heights are km in the file
+and m here; latitudes/longitudes stay in degrees as the grid is defined. The
+header's mapping function, elevation cutoff and base radius are kept.
+numpy/stdlib only.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from pathlib import Path
+
+import numpy as np
+
+from parsers.errors import ParseError
+
+_NEEDED = ("EPOCH OF FIRST MAP", "EPOCH OF LAST MAP", "INTERVAL", "# OF MAPS IN FILE", "BASE RADIUS",
+           "HGT1 / HGT2 / DHGT", "LAT1 / LAT2 / DLAT", "LON1 / LON2 / DLON")
+
+
+@dataclass
+class IonexMaps:
+    """TEC/RMS/height maps on a lat/lon grid: arrays indexed [map, height, lat, lon]."""
+
+    epochs: np.ndarray            # datetime64[ns] UTC, one per map, increasing
+    lat_deg: np.ndarray           # grid latitudes (file order, e.g. 87.5 .. -87.5)
+    lon_deg: np.ndarray           # grid longitudes (e.g. -180 .. 180)
+    height_m: np.ndarray          # shell heights, m (one for 2-D maps)
+    tec: np.ndarray               # TECU
+    rms: np.ndarray | None        # TECU, or None when the files carry no RMS maps
+    hgt: np.ndarray | None        # height maps, m, or None
+    base_radius_m: float
+    mapping_function: str         # 'NONE', 'COSZ', 'QFAC', ...
+    elevation_cutoff_deg: float
+    interval_s: float
+    sources: list = field(default_factory=list)
+
+
+def read_ionex(*paths) -> IonexMaps:
+    """Maps of one or more IONEX files combined in time (grids must agree)."""
+    parts = [_read_one(Path(p)) for p in paths]
+    head = parts[0]
+    for p in parts[1:]:
+        for name in ("lat_deg", "lon_deg", "height_m"):
+            if not np.array_equal(getattr(p, name), getattr(head, name)):
+                raise ParseError(p.sources[0], f"{name} grid differs from {head.sources[0]}")
+    epochs = np.concatenate([p.epochs for p in parts])
+    uniq, first = np.unique(epochs, return_index=True)
+    stacks = {}
+    for name in ("tec", "rms", "hgt"):
+        arrs = [getattr(p, name) for p in parts]
+        if any(a is None for a in arrs):
+            stacks[name] = None
+            continue
+        allm = np.concatenate(arrs)
+        for e in uniq:
+            same = np.flatnonzero(epochs == e)
+            if same.size > 1 and not all(np.array_equal(allm[same[0]], allm[j], equal_nan=True) for j in same[1:]):
+                raise ParseError(parts[0].sources[0], f"{name} maps at {e} differ between files")
+        stacks[name] = allm[first]
+    return IonexMaps(uniq, head.lat_deg, head.lon_deg, head.height_m, stacks["tec"], stacks["rms"], stacks["hgt"],
+                     head.base_radius_m, head.mapping_function, head.elevation_cutoff_deg, head.interval_s,
+                     [s for p in parts for s in p.sources])
+
+
+def _grid(v1, v2, dv, path, line, name):
+    if dv == 0:
+        return np.array([v1])
+    n = int(round((v2 - v1) / dv)) + 1
+    if n < 1 or not np.isclose(v1 + (n - 1) * dv, v2):
+        raise ParseError(path, f"{name} grid {v1} {v2} {dv} is not regular", line=line)
+    return v1 + dv * np.arange(n)
+
+
+def _floats(text, n, path, line, label):
+    try:
+        vals = [float(x) for x in text.split()]
+    except ValueError:
+        raise ParseError(path, f"unreadable numbers in {label}", line=line, record=label) from None
+    if len(vals) < n:
+        raise ParseError(path, f"{label} needs {n} numbers", line=line, record=label)
+    return vals
+
+
+def _epoch(text, path, line, label):
+    v = _floats(text, 6, path, line, label)
+    y, mo, d, h, mi, s = (int(x) for x in v[:6])
+    try:
+        return np.datetime64(f"{y:04d}-{mo:02d}-{d:02d}T{h:02d}:{mi:02d}:{s:02d}", "ns")
+    except ValueError:
+        raise ParseError(path, f"invalid date in {label}", line=line, record=label) from None
+
+
+def _read_one(path: Path) -> IonexMaps:
+    lines = path.read_text(encoding="ascii", errors="replace").splitlines()
+    head, i = {}, 0
+    # ---- header
+    while True:
+        if i >= len(lines):
+            raise ParseError(path, "no END OF HEADER", line=i)
+        label, data = lines[i][60:].strip(), lines[i][:60]
+        i += 1
+        if label == "END OF HEADER":
+            break
+        if label and label != "COMMENT":
+            head.setdefault(label.replace("_", " "), (data, i))
+    if "IONEX VERSION / TYPE" not in head:
+        raise ParseError(path, "missing IONEX VERSION / TYPE", line=1)
+    for name in _NEEDED:
+        if name not in head:
+            raise ParseError(path, f"missing header record {name}", line=i, record=name)
+    h = {k: _floats(v[0], 3 if "/" in k else 1, path, v[1], k) for k, v in head.items()
+         if k in ("INTERVAL", "# OF MAPS IN FILE", "BASE RADIUS", "HGT1 / HGT2 / DHGT", "LAT1 / LAT2 / DLAT",
+                  "LON1 / LON2 / DLON", "ELEVATION CUTOFF", "EXPONENT")}
+    heights = _grid(*h["HGT1 / HGT2 / DHGT"][:3], path, head["HGT1 / HGT2 / DHGT"][1], "HGT")
+    lats = _grid(*h["LAT1 / LAT2 / DLAT"][:3], path, head["LAT1 / LAT2 / DLAT"][1], "LAT")
+    lons = _grid(*h["LON1 / LON2 / DLON"][:3], path, head["LON1 / LON2 / DLON"][1], "LON")
+    first = _epoch(*head["EPOCH OF FIRST MAP"], path, "EPOCH OF FIRST MAP")
+    _epoch(*head["EPOCH OF LAST MAP"], path, "EPOCH OF LAST MAP")
+    exponent = int(h.get("EXPONENT", [-1])[0])
+    nmaps = int(h["# OF MAPS IN FILE"][0])
+    maps = {"TEC": {}, "RMS": {}, "HEIGHT": {}}
+    # ---- data blocks
+    kind = None
+    while i < len(lines):
+        raw = lines[i]
+        label = raw[60:].strip()
+        i += 1
+        if label.startswith("START OF") and label.endswith("MAP"):
+            kind = label[9:-4].strip()
+            if kind not in maps:
+                raise ParseError(path, f"unknown map type {label}", line=i, record=label)
+            number = int(_floats(raw[:60], 1, path, i, label)[0])
+            epoch, grid, exp = None, np.full((heights.size, lats.size, lons.size), np.nan), exponent
+        elif label == "EPOCH OF CURRENT MAP":
+            epoch = _epoch(raw[:60], path, i, label)
+        elif label == "EXPONENT":
+            exp = int(_floats(raw[:60], 1, path, i, label)[0])
+        elif label == "LAT/LON1/LON2/DLON/H":
+            if kind is None or epoch is None:
+                raise ParseError(path, "latitude band outside a map or before EPOCH OF CURRENT MAP", line=i)
+            try:
+                lat, l1, l2, dl, hh = (float(raw[k:k + 6]) for k in (2, 8, 14, 20, 26))
+            except ValueError:
+                raise ParseError(path, "unreadable LAT/LON1/LON2/DLON/H", line=i, record=number) from None
+            row = _grid(l1, l2, dl, path, i, "LON")
+            values, start = [], i
+            while len(values) < row.size:
+                if i >= len(lines) or any(ch.isalpha() for ch in lines[i][60:]):
+                    raise ParseError(path, f"latitude band {lat} ends after {len(values)} of {row.size} values",
+                                     line=i + 1, record=number)
+                text = lines[i].rstrip()
+                for k in range(0, len(text), 5):
+                    field5 = text[k:k + 5]
+                    try:
+                        values.append(int(field5))
+                    except ValueError:
+                        raise ParseError(path, f"bad value {field5.strip()!r} in {kind} map {number}",
+                                         line=i + 1, record=number) from None
+                i += 1
+            try:
+                ih, ilat, ilon = _index(heights, hh), _index(lats, lat), _index(lons, row)
+            except KeyError as err:
+                raise ParseError(path, f"{err.args[0]} not on the header grid", line=start, record=number) from None
+            v = np.asarray(values[:row.size], dtype=float)
+            grid[ih, ilat, ilon] = np.where(v == 9999, np.nan, v * 10.0 ** exp)
+        elif label.startswith("END OF") and label.endswith("MAP"):
+            if kind is None or epoch is None:
+                raise ParseError(path, f"{label} without START OF MAP and EPOCH OF CURRENT MAP", line=i)
+            maps[kind][epoch] = grid
+            kind = None
+        elif label == "END OF FILE":
+            break
+        elif kind is not None and raw.strip() and label not in ("COMMENT",):
+            raise ParseError(path, f"unexpected record {label or raw.strip()[:20]!r} in {kind} map", line=i)
+    if kind is not None:
+        raise ParseError(path, f"file ends inside {kind} map", line=i)
+    if not maps["TEC"]:
+        raise ParseError(path, "no TEC map", line=i)
+    epochs = np.array(sorted(maps["TEC"]), dtype="datetime64[ns]")
+    if len(epochs) != nmaps or epochs[0] != first:
+        raise ParseError(path, f"header says {nmaps} maps from {first}, file has {len(epochs)} from {epochs[0]}")
+    tec = np.stack([maps["TEC"][e] for e in epochs])
+    rms = np.stack([maps["RMS"][e] for e in epochs]) if len(maps["RMS"]) == len(epochs) else None
+    hgt = np.stack([maps["HEIGHT"][e] for e in epochs]) * 1e3 if len(maps["HEIGHT"]) == len(epochs) else None
+    mf = head.get("MAPPING FUNCTION", ("NONE", 0))[0].strip() or "NONE"
+    return IonexMaps(epochs, lats, lons, heights * 1e3, tec, rms, hgt, h["BASE RADIUS"][0] * 1e3, mf,
+                     h.get("ELEVATION CUTOFF", [0.0])[0], h["INTERVAL"][0], [str(path)])
+
+
+def _index(grid, value):
+    """Index (or indices) of ``value`` on a regular grid; KeyError when off the grid."""
+    step = grid[1] - grid[0] if grid.size > 1 else 1.0
+    k = np.rint((np.asarray(value, dtype=float) - grid[0]) / step).astype(int)
+    if np.any(k < 0) or np.any(k >= grid.size) or not np.allclose(grid[np.clip(k, 0, grid.size - 1)], value):
+        raise KeyError(f"{value}")
+    return k
