@@ -1,0 +1,162 @@
+"""Square-root information filter (Bierman 1977) with consider parameters.
+
+The filter keeps the information array ``[R | z]`` of the deviation ``dx`` from
+a reference, with ``R dx = z - nu``, ``nu ~ N(0, I)``. The vector is in registry
+canonical order: ``n_est`` estimated parameters, then consider parameters whose
+a priori (deviation ``c_bar``, sigma ``c_sigma``) is never replaced by data.
+
+Operations, all by Householder triangularization (LAPACK geqrf):
+
+* :meth:`SRIF.measurement_update` -- rows ``H dx = y + eps``, ``eps ~ N(0, sigma^2)``;
+* :meth:`SRIF.time_update` -- deterministic map ``dx+ = Phi dx``;
+* :meth:`SRIF.process_noise` -- Bierman's colored-noise update of stochastic
+  parameters ``p+ = m p + w`` at one instant (m = 0 white, 0 < m < 1
+  Gauss-Markov, m = 1 random walk); its eliminated rows are kept for the smoother.
+
+Every operation is appended to ``SRIF.log`` so that :mod:`.smoother` can run the
+square-root information smoother backwards.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+from scipy.linalg import solve_triangular
+
+
+def triangularize(A: np.ndarray) -> np.ndarray:
+    """Upper-triangular factor of ``A`` by Householder QR (rows ``min(m, n)``)."""
+    return np.linalg.qr(A, mode="r")
+
+
+@dataclass(frozen=True)
+class Gaussian:
+    """Estimate of the deviation and its covariances (registry units).
+
+    P: computed (noise-only) covariance; consider parameters carry their a priori.
+    P_consider: covariance including the effect of consider-parameter errors.
+    """
+
+    x: np.ndarray
+    P: np.ndarray
+    P_consider: np.ndarray
+
+    @property
+    def sigma(self) -> np.ndarray:
+        return np.sqrt(np.diag(self.P_consider))
+
+
+def solve_information(R, z, n_est, c_bar, c_sigma) -> Gaussian:
+    """Estimate and covariances from an information array (any row order)."""
+    n = R.shape[1]
+    T = triangularize(np.column_stack([R, z]))
+    Ree, Rec, ze = T[:n_est, :n_est], T[:n_est, n_est:n], T[:n_est, n]
+    Rinv = solve_triangular(Ree, np.eye(n_est))
+    S = Rinv @ Rec                          # -d(x_e)/d(c)
+    x = np.concatenate([Rinv @ (ze - Rec @ c_bar), c_bar])
+    Pcc = np.diag(c_sigma**2)
+    P = np.zeros((n, n))
+    P[:n_est, :n_est] = Rinv @ Rinv.T
+    P[n_est:, n_est:] = Pcc
+    Pc = P.copy()
+    SP = S @ Pcc
+    Pc[:n_est, :n_est] += SP @ S.T
+    Pc[:n_est, n_est:] = -SP
+    Pc[n_est:, :n_est] = -SP.T
+    return Gaussian(x, P, Pc)
+
+
+class SRIF:
+    """Square-root information filter on an ``n``-vector, the last ``n - n_est`` considered."""
+
+    def __init__(self, R, z, n_est=None, c_bar=None, c_sigma=None):
+        self.R = np.array(R, dtype=float)
+        self.z = np.array(z, dtype=float)
+        n = self.R.shape[1]
+        self.n_est = n if n_est is None else int(n_est)
+        nc = n - self.n_est
+        self.c_bar = np.zeros(nc) if c_bar is None else np.asarray(c_bar, float)
+        self.c_sigma = np.ones(nc) if c_sigma is None else np.asarray(c_sigma, float)
+        self.chi2 = 0.0          # accumulated whitened residual sum of squares
+        self.log: list = []
+
+    @classmethod
+    def from_apriori(cls, sigma, dx=None, n_est=None):
+        """Diagonal a priori: deviation ``dx`` (default 0) with standard deviations ``sigma``."""
+        sigma = np.asarray(sigma, float)
+        dx = np.zeros_like(sigma) if dx is None else np.asarray(dx, float)
+        n_est = sigma.size if n_est is None else n_est
+        return cls(np.diag(1.0 / sigma), dx / sigma, n_est, dx[n_est:], sigma[n_est:])
+
+    @property
+    def n(self) -> int:
+        return self.R.shape[1]
+
+    def _set(self, T):
+        self.R, self.z = T[: self.n, : self.n], T[: self.n, self.n]
+
+    # -- updates ---------------------------------------------------------
+    def measurement_update(self, H, y, sigma) -> np.ndarray:
+        """Absorb rows ``H dx = y`` with noise ``sigma``; return whitened post-update residuals."""
+        w = 1.0 / np.asarray(sigma, float)
+        H = np.atleast_2d(H)
+        A = np.vstack([np.column_stack([self.R, self.z]),
+                       np.column_stack([H * w[:, None], np.asarray(y) * w])])
+        T = triangularize(A)
+        self._set(T)
+        e = T[self.n :, self.n] if T.shape[0] > self.n else np.zeros(0)
+        self.chi2 += float(e @ e)
+        return e
+
+    def time_update(self, Phi):
+        """Deterministic map ``dx+ = Phi dx`` (Phi invertible, n x n)."""
+        RPhiInv = np.linalg.solve(Phi.T, self.R.T).T
+        self._set(triangularize(np.column_stack([RPhiInv, self.z])))
+        self.log.append(("map", Phi))
+
+    def process_noise(self, idx, m, q, offset=None):
+        """Colored-noise step ``p+ = m p + offset + w``, ``w ~ N(0, q)`` on parameters ``idx``.
+
+        ``offset`` (default 0) is the reference's own jump, ``m p_ref - p+_ref``
+        with sign so that deviations obey the equation above.
+        """
+        idx = np.asarray(idx, int)
+        k = idx.size
+        m = np.broadcast_to(np.asarray(m, float), (k,))
+        sq = np.sqrt(np.broadcast_to(np.asarray(q, float), (k,)))
+        off = np.zeros(k) if offset is None else np.asarray(offset, float)
+        n = self.n
+        # variables: [p_old (k) | dx_new (n)]; dx_new carries p_new in slots idx
+        A = np.zeros((n + k, k + n + 1))
+        A[:n, :k] = self.R[:, idx]
+        rest = np.ones(n, bool)
+        rest[idx] = False
+        A[:n, k:k + n][:, rest] = self.R[:, rest]
+        A[:n, -1] = self.z
+        A[n:, :k] = np.diag(-m / sq)
+        A[n + np.arange(k), k + idx] = 1.0 / sq
+        A[n:, -1] = off / sq
+        T = triangularize(A)
+        self.log.append(("noise", idx, T[:k, :k], T[:k, k:k + n], T[:k, -1]))
+        self.R, self.z = T[k:, k:k + n], T[k:, -1]
+
+    def mark(self, label):
+        """Record a point where the smoother should report (e.g. a grid epoch)."""
+        self.log.append(("mark", label))
+
+    # -- read-out ---------------------------------------------------------
+    def gaussian(self) -> Gaussian:
+        return solve_information(self.R, self.z, self.n_est, self.c_bar, self.c_sigma)
+
+    def innovations(self, H, y, sigma):
+        """Pre-update residuals ``y - H x`` and their predicted standard deviations.
+
+        The prediction variance includes the estimate's covariance with the
+        consider parameters' effect, and the measurement noise.
+        """
+        g = self.gaussian()
+        H = np.atleast_2d(H)
+        nu = np.asarray(y) - H @ g.x
+        s2 = np.sum((H @ g.P_consider) * H, axis=1) + np.asarray(sigma, float) ** 2
+        return nu, np.sqrt(s2)
