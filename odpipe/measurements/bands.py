@@ -1,0 +1,50 @@
+"""Radio bands: the speed of light, transponder turnaround ratios and range-unit factors.
+
+Facts from Moyer, *Formulation for Observed and Computed Values of Deep Space
+Network Data Types for Navigation* (DESCANSO Monograph 2), chapter 13, and the
+DSN Telecommunications Link Design Handbook (810-005):
+
+* turnaround ratio M2 = f_down / f_up of a coherent transponder, per band pair;
+* range unit (RU): sequential and PN range is counted in cycles of a signal
+  derived from the uplink. The range in RU accumulated between transmission t1
+  and reception t3 is ``F * integral(f_up dt, t1, t3)`` with
+  F = 1/2 (S-band uplink), 221/(749*2) (X-band uplink), 221/(3599*2) (Ka-band uplink).
+  One RU is therefore about 1/(F f_up) seconds of round-trip light time.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+C_LIGHT = 299_792_458.0  # m/s, exact
+
+# (uplink band, downlink band) -> M2 = f_down / f_up
+TURNAROUND = {
+    ("S", "S"): 240 / 221,
+    ("S", "X"): 880 / 221,
+    ("X", "S"): 240 / 749,
+    ("X", "X"): 880 / 749,
+    ("X", "Ka"): 3344 / 749,
+    ("Ka", "Ka"): 3599 / 3344,
+}
+
+# uplink band -> F (range units per cycle of uplink)
+RANGE_UNIT_FACTOR = {"S": 1 / 2, "X": 221 / (749 * 2), "Ka": 221 / (3599 * 2)}
+
+
+def turnaround_ratio(band_up, band_down) -> np.ndarray:
+    """M2 = f_down/f_up per row (dimensionless); NaN where the band pair is unknown or one-way."""
+    up = np.atleast_1d(np.asarray(band_up, dtype=object))
+    down = np.broadcast_to(np.atleast_1d(np.asarray(band_down, dtype=object)), up.shape)
+    return np.array([TURNAROUND.get((_norm(u), _norm(d)), np.nan) for u, d in zip(up, down)])
+
+
+def range_unit_factor(band_up) -> np.ndarray:
+    """F per row (RU per uplink cycle); NaN for an unknown band."""
+    up = np.atleast_1d(np.asarray(band_up, dtype=object))
+    return np.array([RANGE_UNIT_FACTOR.get(_norm(u), np.nan) for u in up])
+
+
+def _norm(band) -> str:
+    b = str(band).strip()
+    return "Ka" if b.upper() == "KA" else b.upper()
