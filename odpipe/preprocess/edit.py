@@ -1,0 +1,141 @@
+"""Data editing: each editor returns a row mask for one edit reason; :func:`edit` applies them.
+
+Rows are flagged (``flags`` bits, :mod:`odpipe.preprocess.flags`), never dropped.
+Editors look only at columns, so they run on any TrackingTable:
+
+* elevation mask: ``elevation`` column (rad), supplied by station geometry;
+* duplicates: same link and time tag as an earlier row (the first is kept);
+* format validity: ``validity`` != 0 (ODF) or ``valid`` false;
+* blunders: per pass, a gross test on the values and a robust (median/MAD)
+  test on the signal detrended by piecewise polynomials between uplink ramp changes;
+* range ambiguity: range outside [0, modulus) (``range_modulus_ru`` column);
+* short passes, outside the arc, analyst windows.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+import numpy as np
+import pandas as pd
+
+from odpipe.preprocess import ramp_segments
+from odpipe.preprocess.flags import Flag, set_flag, summary
+from odpipe.preprocess.passes import LINK, assign_passes
+from odpipe.preprocess.robust import gross, robust_detrend
+from odpipe.preprocess.timetags import interval_bounds
+
+
+@dataclass
+class EditConfig:
+    """Editing settings (SI: s, rad)."""
+
+    min_elevation: float = np.radians(10.0)
+    blunder_k: float = 8.0          # robust sigmas of the detrended signal
+    gross_k: float = 20.0           # robust sigmas of the pass's values
+    piece: float = 300.0            # s, length of the detrending polynomial pieces
+    degree: int = 5
+    ramp_guard: float = 10.0        # s after a ramp change kept apart (round-trip light time)
+    min_pass_samples: int = 10
+    min_pass_duration: float = 0.0  # s
+    arc: tuple | None = None        # (start, end) UTC
+    windows: list = field(default_factory=list)  # analyst windows: dicts start, end[, station_rx, observable]
+    max_gap: float = 600.0          # s, pass break
+
+
+def _ns(table):
+    return table["epoch"].to_numpy().astype("datetime64[ns]").view(np.int64)
+
+
+def below_elevation(table: pd.DataFrame, min_elevation: float) -> np.ndarray:
+    """Rows whose ``elevation`` (rad) is below ``min_elevation``; none if the column is absent."""
+    if "elevation" not in table:
+        return np.zeros(len(table), dtype=bool)
+    return table["elevation"].to_numpy(dtype=float) < min_elevation
+
+
+def duplicates(table: pd.DataFrame) -> np.ndarray:
+    """Rows repeating an earlier row's link and time tag."""
+    return table.duplicated(subset=LINK + ["epoch"], keep="first").to_numpy()
+
+
+def invalid(table: pd.DataFrame) -> np.ndarray:
+    """Rows the format marks invalid (``validity`` != 0, or ``valid`` false)."""
+    bad = np.zeros(len(table), dtype=bool)
+    if "validity" in table:
+        bad |= table["validity"].to_numpy() != 0
+    if "valid" in table:
+        bad |= ~table["valid"].to_numpy(dtype=bool)
+    return bad
+
+
+def blunders(table: pd.DataFrame, ramps: pd.DataFrame | None = None, config: EditConfig = EditConfig(),
+             use: np.ndarray | None = None) -> np.ndarray:
+    """Gross outliers per pass (``pass_id`` must be set). Only rows with ``use`` true are tested."""
+    use = np.ones(len(table), dtype=bool) if use is None else np.asarray(use, dtype=bool)
+    v = table["value"].to_numpy(dtype=float)
+    use = use & np.isfinite(v)
+    pid = table["pass_id"].to_numpy()
+    start, _ = interval_bounds(_ns(table), table["count_time"].to_numpy(), table["tag"].to_numpy())
+    tx, ramped = table["station_tx"].to_numpy(), table["ramped"].to_numpy()
+    seg = ramp_segments.segment_index(tx, ramped, start, ramps)
+    seg_late = ramp_segments.segment_index(tx, ramped, start - int(config.ramp_guard * 1e9), ramps)
+    stretch = pd.MultiIndex.from_arrays([pid, seg, seg_late]).factorize()[0]
+    bad = use & gross(v, pid, config.gross_k, use)
+    t = (start - start.min()) / 1e9 if len(start) else start
+    _, inlier = robust_detrend(t, v, stretch, use=use & ~bad, piece=config.piece, degree=config.degree,
+                               k=config.blunder_k)
+    return bad | (use & ~bad & ~inlier)
+
+
+def range_outside_modulus(table: pd.DataFrame) -> np.ndarray:
+    """Range rows outside [0, modulus) where the format gives the modulus (``range_modulus_ru``)."""
+    if "range_modulus_ru" not in table:
+        return np.zeros(len(table), dtype=bool)
+    mod = table["range_modulus_ru"].to_numpy(dtype=float)
+    v = table["value"].to_numpy(dtype=float)
+    return (table["observable"].to_numpy() == "range") & np.isfinite(mod) & ((v < 0) | (v >= mod))
+
+
+def short_passes(table: pd.DataFrame, min_samples: int, min_duration: float) -> np.ndarray:
+    """Rows of passes with fewer than ``min_samples`` rows or lasting less than ``min_duration`` s."""
+    g = table.groupby("pass_id")["epoch"]
+    n = g.transform("size").to_numpy()
+    dur = (g.transform("max") - g.transform("min")).dt.total_seconds().to_numpy()
+    return (n < min_samples) | (dur < min_duration)
+
+
+def outside_arc(table: pd.DataFrame, start, end) -> np.ndarray:
+    """Rows tagged before ``start`` or after ``end`` (UTC)."""
+    e = table["epoch"]
+    return ((e < pd.Timestamp(start)) | (e > pd.Timestamp(end))).to_numpy()
+
+
+def in_windows(table: pd.DataFrame, windows: list) -> np.ndarray:
+    """Rows inside any analyst window {start, end[, station_rx][, observable]} (times UTC, inclusive)."""
+    hit = np.zeros(len(table), dtype=bool)
+    for w in windows:
+        m = (table["epoch"] >= pd.Timestamp(w["start"])) & (table["epoch"] <= pd.Timestamp(w["end"]))
+        for col in ("station_rx", "observable"):
+            if w.get(col):
+                m &= table[col] == w[col]
+        hit |= m.to_numpy()
+    return hit
+
+
+def edit(table: pd.DataFrame, ramps: pd.DataFrame | None = None, config: EditConfig = EditConfig()):
+    """Flag ``table`` with every editor; returns (new table, summary of rows per reason)."""
+    out = assign_passes(table, ramps, max_gap=config.max_gap) if (table["pass_id"] < 0).any() else table.copy()
+    flags = out["flags"].to_numpy(dtype=np.int64)
+    flags = set_flag(flags, invalid(out), Flag.INVALID)
+    flags = set_flag(flags, duplicates(out), Flag.DUPLICATE)
+    flags = set_flag(flags, below_elevation(out, config.min_elevation), Flag.ELEVATION)
+    flags = set_flag(flags, range_outside_modulus(out), Flag.AMBIGUITY)
+    untested = (flags & int(Flag.INVALID | Flag.DUPLICATE | Flag.AMBIGUITY)) != 0
+    flags = set_flag(flags, blunders(out, ramps, config, use=~untested), Flag.BLUNDER)
+    flags = set_flag(flags, short_passes(out, config.min_pass_samples, config.min_pass_duration), Flag.SHORT_PASS)
+    if config.arc is not None:
+        flags = set_flag(flags, outside_arc(out, *config.arc), Flag.OUTSIDE_ARC)
+    flags = set_flag(flags, in_windows(out, config.windows), Flag.USER)
+    out["flags"] = flags
+    return out, summary(flags)

@@ -1,0 +1,137 @@
+"""Editors against synthetic truth and the real GRAIL ODF outliers."""
+
+import numpy as np
+import pandas as pd
+import pytest
+
+from odpipe.preprocess import ambiguity, weights
+from odpipe.preprocess.edit import EditConfig, edit
+from odpipe.preprocess.flags import Flag, names, summary
+from odpipe.preprocess.robust import outliers
+from parsers.table import build
+
+T0 = np.datetime64("2012-04-09T00:00:00", "ns")
+
+
+def sine_doppler(n=7200, sigma=0.005, seed=0, **kw):
+    """1-s Doppler of a lunar orbiter (30 kHz amplitude, 2-h period) plus white noise."""
+    rng = np.random.default_rng(seed)
+    t = np.arange(n) + 0.5
+    v = 3.0e4 * np.sin(2 * np.pi * t / 6800.0) + 0.02 * np.sin(2 * np.pi * t / 90.0) + rng.normal(0, sigma, n)
+    cols = dict(epoch=T0 + (t * 1e9).astype("timedelta64[ns]"), tag="interval_mid", observable="doppler_1way",
+                value=v, unit="Hz", count_time=1.0, station_rx="DSS-34", spacecraft="181", band_down="X",
+                source="synthetic", record=np.arange(n), flags=0)
+    cols.update(kw)
+    return build(n, **cols)
+
+
+def bits(table, flag):
+    return (table["flags"].to_numpy() & int(flag)) != 0
+
+
+def test_blunders_found_exactly_on_a_noisy_orbit_signal():
+    tab = sine_doppler()
+    hit = np.array([5, 700, 701, 3000, 7199])
+    tab.loc[hit, "value"] += np.array([1e8, 0.5, -0.3, 2.0, -5e4])  # 60..1e10 sigma
+    out, summ = edit(tab)
+    assert np.array_equal(np.flatnonzero(bits(out, Flag.BLUNDER)), hit)
+    assert len(out) == len(tab)
+    assert summ.set_index("reason").loc["blunder", "rows"] == len(hit)
+
+
+def test_duplicates_invalid_elevation_short_pass_arc_and_windows():
+    tab = sine_doppler(n=600)
+    tab = pd.concat([tab, tab.iloc[[10]]], ignore_index=True)          # row 600 repeats row 10
+    tab["validity"] = 0
+    tab.loc[20, "validity"] = 1
+    tab["elevation"] = np.radians(np.linspace(5.0, 40.0, len(tab)))     # below 10 deg for the first rows
+    late = sine_doppler(n=5, record=np.arange(1000, 1005), epoch=T0 + np.arange(5) * np.timedelta64(1, "s")
+                        + np.timedelta64(2, "h"))
+    late["validity"], late["elevation"] = 0, 1.0
+    tab = pd.concat([tab, late], ignore_index=True)
+    cfg = EditConfig(arc=(T0, T0 + np.timedelta64(590, "s")),
+                     windows=[{"start": T0 + np.timedelta64(300, "s"), "end": T0 + np.timedelta64(310, "s"),
+                               "station_rx": "DSS-34"}])
+    out, _ = edit(tab, config=cfg)
+    assert np.flatnonzero(bits(out, Flag.DUPLICATE)).tolist() == [600]
+    assert np.flatnonzero(bits(out, Flag.INVALID)).tolist() == [20]
+    el = np.degrees(tab["elevation"].to_numpy())
+    assert np.array_equal(bits(out, Flag.ELEVATION), el < 10.0)
+    assert np.flatnonzero(bits(out, Flag.SHORT_PASS)).tolist() == list(range(601, 606))
+    assert bits(out, Flag.OUTSIDE_ARC).sum() == 10 + 5       # tags 590.5..599.5 s and the late pass
+    assert np.flatnonzero(bits(out, Flag.USER)).tolist() == list(range(300, 310))
+    assert names(out["flags"].iloc[601]) == ["short_pass", "outside_arc"]
+
+
+def test_range_outside_its_modulus_is_flagged():
+    tab = build(4, epoch=T0 + np.arange(4) * np.timedelta64(600, "s"), tag="receive", observable="range",
+                value=[10.0, 2.0 ** 25, -1.0, 3.3e7], unit="RU", count_time=0.0, station_rx="DSS-25",
+                source="synthetic", record=np.arange(4), flags=0, range_modulus_ru=2.0 ** 25)
+    out, _ = edit(tab, config=EditConfig(min_pass_samples=1))
+    assert bits(out, Flag.AMBIGUITY).tolist() == [False, True, True, False]
+
+
+def test_ambiguity_resolution_recovers_the_true_range():
+    rng = np.random.default_rng(4)
+    modulus = 2.0 ** 25
+    true = rng.uniform(1e8, 1e10, 1000)
+    observed = np.mod(true, modulus)
+    resolved, amb = ambiguity.resolve(observed, true + rng.normal(0, 1e5, 1000), modulus)
+    assert not amb.any() and np.allclose(resolved, true, rtol=0, atol=1e-3)
+    _, amb = ambiguity.resolve(observed, true + 0.45 * modulus, modulus)
+    assert amb.all()
+
+
+def test_residual_outliers_per_group():
+    rng = np.random.default_rng(5)
+    r = np.concatenate([rng.normal(0, 1.0, 500), rng.normal(0, 10.0, 500)])
+    g = np.repeat([0, 1], 500)
+    r[[3, 600]] = [20.0, 200.0]  # 20 sigma in each group; 20 would be normal in group 1
+    assert np.flatnonzero(outliers(r, g, k=6.0)).tolist() == [3, 600]
+
+
+def test_station_weights_from_postfit_rms():
+    rng = np.random.default_rng(6)
+    a, b = sine_doppler(n=4000, station_rx="DSS-24"), sine_doppler(n=4000, station_rx="DSS-54")
+    tab = pd.concat([a, b], ignore_index=True)
+    resid = np.concatenate([rng.normal(0, 0.002, 4000), rng.normal(0, 0.008, 4000)])
+    tab.loc[[0, 1], "flags"] = int(Flag.BLUNDER)
+    resid[:2] = 1e3  # flagged rows do not count
+    w = weights.station_weights(tab, resid)
+    rms = w.set_index("station_rx")["rms"]
+    assert rms["DSS-24"] == pytest.approx(0.002, rel=0.05) and rms["DSS-54"] == pytest.approx(0.008, rel=0.05)
+    assert w.set_index("station_rx")["rows"]["DSS-24"] == 3998
+    out = weights.apply_weights(tab, w)
+    assert np.allclose(out.loc[out["station_rx"] == "DSS-54", "sigma"], rms["DSS-54"])
+
+
+def test_summary_counts_each_reason():
+    s = summary([0, int(Flag.BLUNDER), int(Flag.BLUNDER | Flag.ELEVATION), 0]).set_index("reason")["rows"]
+    assert s["blunder"] == 2 and s["elevation"] == 1 and s["used"] == 2 and s["duplicate"] == 0
+
+
+# The 1-way (and one 2-way) GRAIL records flagged valid although |value| is 1e6..1.5e9 Hz.
+GRAIL_OUTLIERS = {
+    "grblugf2012_099_0620smmmv1.odf": [21121],
+    "grblugf2012_100_0434smmmv1.odf": [9101, 9224, 16950, 44459, 50347],
+    "grblugf2012_102_0055smmmv1.odf": [58401],
+}
+
+
+@pytest.mark.realdata
+@pytest.mark.parametrize("name", sorted(GRAIL_OUTLIERS))
+def test_grail_gross_outliers_are_flagged(shared_data, name):
+    odf = pytest.importorskip("parsers.odf")
+    data = odf.read(shared_data / "grail" / name)
+    tab = data.table
+    big = tab.loc[tab["value"].abs() > 1e6, "record"].tolist()
+    assert big == GRAIL_OUTLIERS[name]  # the file's text: these records are the 1e6..1e9 Hz values
+    assert (tab["validity"] == 0).all()  # ... and the format calls them valid
+    out, summ = edit(tab, data.ramps)
+    assert len(out) == len(tab)
+    blunder = out.loc[bits(out, Flag.BLUNDER), "record"]
+    assert set(GRAIL_OUTLIERS[name]) <= set(blunder)
+    # everything above 1e5 Hz is far outside any pass's Doppler and is caught too
+    assert bits(out, Flag.BLUNDER)[tab["value"].abs().to_numpy() > 1e5].all()
+    # editing is selective: under 1 % of the rows
+    assert summ.set_index("reason").loc["blunder", "rows"] < 0.01 * len(tab)
