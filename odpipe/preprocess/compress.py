@@ -202,6 +202,7 @@ def compress(table: pd.DataFrame, count_time: float = 60.0, *, ramps: pd.DataFra
     """
     if partial not in ("keep", "flag", "drop"):
         raise ValueError(f"partial must be keep, flag or drop, not {partial!r}")
+    ramps = ramp_segments.store(ramps)
     if (table["pass_id"] < 0).any():
         table = assign_passes(table, ramps, max_gap=max_gap)
     count_ns, tol_ns = int(round(count_time * 1e9)), int(round(tol * 1e9))

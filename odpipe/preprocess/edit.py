@@ -80,7 +80,7 @@ def blunders(table: pd.DataFrame, ramps: pd.DataFrame | None = None, config: Edi
     tx, ramped = table["station_tx"].to_numpy(), table["ramped"].to_numpy()
     seg = ramp_segments.segment_index(tx, ramped, start, ramps)
     seg_late = ramp_segments.segment_index(tx, ramped, start - int(config.ramp_guard * 1e9), ramps)
-    stretch = pd.MultiIndex.from_arrays([pid, seg, seg_late]).factorize()[0]
+    stretch = pd.DataFrame({"p": pid, "s": seg, "l": seg_late}).groupby(["p", "s", "l"], sort=False).ngroup().to_numpy()
     bad = use & gross(v, pid, config.gross_k, use)
     t = (start - start.min()) / 1e9 if len(start) else start
     _, inlier = robust_detrend(t, v, stretch, use=use & ~bad, piece=config.piece, degree=config.degree,
@@ -125,6 +125,7 @@ def in_windows(table: pd.DataFrame, windows: list) -> np.ndarray:
 
 def edit(table: pd.DataFrame, ramps: pd.DataFrame | None = None, config: EditConfig = EditConfig()):
     """Flag ``table`` with every editor; returns (new table, summary of rows per reason)."""
+    ramps = ramp_segments.store(ramps)
     out = assign_passes(table, ramps, max_gap=config.max_gap) if (table["pass_id"] < 0).any() else table.copy()
     flags = out["flags"].to_numpy(dtype=np.int64)
     flags = set_flag(flags, invalid(out), Flag.INVALID)

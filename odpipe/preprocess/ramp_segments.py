@@ -1,8 +1,8 @@
-"""Which uplink ramp segment each sample was counted under, and where ramps jump.
+"""Which uplink ramp segment each sample was counted under, and where ramps are discontinuous.
 
-A ramp table (:data:`parsers.table.RAMP_COLUMNS`) lists linear segments per
-transmitting station. A new segment whose start frequency differs from the
-previous segment extrapolated to that instant is a *discontinuity* (a jump).
+Ramps go through :class:`parsers.ramps.RampStore`, which merges, deduplicates and
+checks them; its ``jump`` findings (a retuning) and ``gap`` findings (no ramp
+in force) are the discontinuities that end a pass.
 """
 
 from __future__ import annotations
@@ -10,49 +10,50 @@ from __future__ import annotations
 import numpy as np
 import pandas as pd
 
-
-def _sorted(ramps: pd.DataFrame) -> pd.DataFrame:
-    return ramps.sort_values(["station", "start"], kind="stable")
+from parsers.ramps import RampStore
 
 
-def ramp_jumps(ramps: pd.DataFrame, tol_hz: float = 1.0) -> pd.Series:
-    """True for ramp rows that start with a frequency jump > ``tol_hz`` (Hz) from the previous segment.
+def store(ramps, jump_tol_hz: float = 1.0) -> RampStore | None:
+    """A RampStore from a ramp table (or the store itself); None when there are no ramps."""
+    if ramps is None or isinstance(ramps, RampStore):
+        return ramps
+    return RampStore(ramps, jump_tol_hz=jump_tol_hz) if len(ramps) else None
 
-    The first segment of a station is not a jump. Index as ``ramps``.
+
+def discontinuities(rs: RampStore) -> pd.DataFrame:
+    """Per station, the UTC instants where the uplink frequency jumps or a coverage gap ends."""
+    f = rs.findings
+    jump = f.loc[f["kind"] == "jump", ["station", "start"]].rename(columns={"start": "at"})
+    gap = f.loc[f["kind"] == "gap", ["station", "end"]].rename(columns={"end": "at"})
+    out = pd.concat([jump, gap], ignore_index=True)
+    out["at"] = pd.to_datetime(out["at"]).astype("datetime64[ns]")
+    return out.sort_values(["station", "at"], kind="stable").reset_index(drop=True)
+
+
+def segment_index(station_tx, ramped, start_ns, ramps, *, jumps_only: bool = False,
+                  jump_tol_hz: float = 1.0) -> np.ndarray:
+    """Label of the ramp segment in force at each sample's ``start_ns`` (int64 ns), per station.
+
+    With ``jumps_only`` the label counts discontinuities instead, so it changes
+    only where the ramp is discontinuous. -1 for unramped samples and before a
+    station's first ramp.
     """
-    r = _sorted(ramps)
-    same = r["station"].to_numpy() == np.roll(r["station"].to_numpy(), 1)
-    same[:1] = False
-    dt = (r["start"] - r["start"].shift(1)).dt.total_seconds().to_numpy()
-    predicted = r["freq_hz"].shift(1).to_numpy() + r["rate_hz_s"].shift(1).to_numpy() * dt
-    jump = same & (np.abs(r["freq_hz"].to_numpy() - predicted) > tol_hz)
-    return pd.Series(jump, index=r.index).reindex(ramps.index)
-
-
-def segment_index(station_tx, ramped, start_ns, ramps: pd.DataFrame | None, *, jumps_only: bool = False):
-    """For each sample, the position (in ``ramps``' station-sorted order) of the ramp in effect at ``start_ns``.
-
-    With ``jumps_only`` the count is of jumps up to that time instead, so it
-    changes only at discontinuities. -1 where the sample is not ramped or no
-    ramp of its station has started yet.
-    """
-    n = len(start_ns)
-    out = np.full(n, -1, dtype=np.int64)
-    if ramps is None or len(ramps) == 0:
+    out = np.full(len(start_ns), -1, dtype=np.int64)
+    rs = store(ramps, jump_tol_hz)
+    if rs is None:
         return out
-    r = _sorted(ramps)
-    starts = r["start"].to_numpy().astype("datetime64[ns]").view(np.int64)
-    jump = ramp_jumps(r).to_numpy()
+    if jumps_only:
+        marks = discontinuities(rs)
+        times, stations = marks["at"].to_numpy().view(np.int64), marks["station"].to_numpy()
+    else:
+        times = rs.segments["start"].to_numpy().astype("datetime64[ns]").view(np.int64)
+        stations = rs.segments["station"].to_numpy()
     station_tx = np.asarray(station_tx, dtype=object)
     ramped = np.asarray(ramped, dtype=bool)
-    stations = r["station"].to_numpy()
-    for st in np.unique(stations):
-        lo, hi = np.searchsorted(stations, st, "left"), np.searchsorted(stations, st, "right")
+    start_ns = np.asarray(start_ns, dtype=np.int64)
+    for st in np.unique(rs.segments["station"].to_numpy()):
+        mine = np.flatnonzero(stations == st)
         rows = np.flatnonzero(ramped & (station_tx == st))
-        k = np.searchsorted(starts[lo:hi], start_ns[rows], side="right") - 1
-        if jumps_only:
-            marks = np.concatenate([[0], np.cumsum(jump[lo:hi])])
-            out[rows] = np.where(k >= 0, lo + marks[k + 1], -1)
-        else:
-            out[rows] = np.where(k >= 0, lo + k, -1)
+        k = np.searchsorted(times[mine], start_ns[rows], side="right")
+        out[rows] = k if jumps_only else np.where(k > 0, mine[0] + k - 1 if len(mine) else -1, -1)
     return out

@@ -60,12 +60,14 @@ def _chunks(t_s: np.ndarray, group: np.ndarray, length: float) -> np.ndarray:
     span = t.groupby(g).transform("max").to_numpy() - t.groupby(g).transform("min").to_numpy()
     last = np.maximum(np.floor(span / length) - 1, 0)
     piece = np.minimum(np.floor(rel / length), last)
-    return pd.MultiIndex.from_arrays([group, piece]).factorize()[0] if len(t_s) else np.zeros(0, dtype=np.int64)
+    return pd.DataFrame({"g": group, "p": piece}).groupby(["g", "p"], sort=False).ngroup().to_numpy()
 
 
-def _fit(x, v, w, chunk, n_chunks, degree):
-    """Weighted least-squares polynomial in x per chunk (batched normal equations); fitted values."""
-    powers = x[:, None] ** np.arange(2 * degree + 1)
+def _fit(powers, v, w, chunk, n_chunks, degree):
+    """Weighted least-squares polynomial per chunk (batched normal equations); fitted values.
+
+    ``powers`` holds x**0 .. x**(2 degree) per row.
+    """
     s = np.stack([np.bincount(chunk, weights=w * powers[:, j], minlength=n_chunks)
                   for j in range(2 * degree + 1)], axis=1)
     b = np.stack([np.bincount(chunk, weights=w * powers[:, j] * v, minlength=n_chunks)
@@ -98,8 +100,9 @@ def robust_detrend(t_s: np.ndarray, values: np.ndarray, group: np.ndarray, *, us
     centre = np.nan_to_num(centre)
     y = v - centre
     inlier = use & (np.abs(y) <= 10 * np.nan_to_num(mad_sigma(v, chunk, use), nan=np.inf) + 1e-300)
+    powers = x[:, None] ** np.arange(2 * degree + 1)
     for _ in range(iterations):
-        resid = y - _fit(x, np.where(inlier, y, 0.0), inlier.astype(float), chunk, n_chunks, degree)
+        resid = y - _fit(powers, np.where(inlier, y, 0.0), inlier.astype(float), chunk, n_chunks, degree)
         sig = mad_sigma(resid, chunk, inlier)
         inlier = use & (np.abs(resid) <= k * np.nan_to_num(sig, nan=np.inf))
     return resid, inlier
