@@ -1,0 +1,82 @@
+"""CCSDS epochs (YYYY-MM-DDThh:mm:ss[.f] or YYYY-DDDThh:mm:ss[.f], optional Z) <-> datetime64[ns].
+
+TAI, GPS and TT epochs are turned into UTC with the leap-second table of the
+``astropy_iers_data`` package (its Leap_Second.dat, read as a data file at run time, not
+imported). Other time systems (TDB, TCB, TCG, UT1, ...) are kept in their own scale:
+those rows' ``epoch`` is not UTC and their ``time_system`` column says so.
+"""
+
+from __future__ import annotations
+
+import importlib.util
+from functools import lru_cache
+from pathlib import Path
+
+import numpy as np
+import pandas as pd
+
+# Seconds to add to TAI to get each scale.
+_FROM_TAI = {"TAI": 0.0, "GPS": -19.0, "TT": 32.184}
+LEAP_SCALES = set(_FROM_TAI)
+
+
+def from_text(text: np.ndarray) -> np.ndarray:
+    """datetime64[ns] of CCSDS epoch strings; NaT where a string is not an epoch."""
+    s = pd.Series(np.asarray(text, dtype=object)).str.strip().str.rstrip("Z")
+    doy = s.str.match(r"^\d{4}-\d{3}T")
+    out = pd.to_datetime(s.where(~doy), format="%Y-%m-%dT%H:%M:%S.%f", errors="coerce").to_numpy("datetime64[ns]")
+    plain = pd.to_datetime(s.where(~doy), format="%Y-%m-%dT%H:%M:%S", errors="coerce").to_numpy("datetime64[ns]")
+    out = np.where(np.isnat(out), plain, out)
+    if doy.any():
+        d = s[doy]
+        year = pd.to_numeric(d.str[:4], errors="coerce")
+        day = pd.to_numeric(d.str[5:8], errors="coerce")
+        clock = pd.to_timedelta(d.str[9:], errors="coerce")
+        bad = (day < 1) | (day > 366) | clock.isna() | (clock >= pd.Timedelta(days=1))
+        jan1 = pd.to_datetime(year.astype("Int64").astype(str) + "-01-01", errors="coerce")
+        value = jan1 + pd.to_timedelta(day - 1, unit="D") + clock
+        out[doy.to_numpy()] = np.where(bad, np.datetime64("NaT"), value.to_numpy("datetime64[ns]"))
+    return out
+
+
+def to_text(epochs: np.ndarray) -> np.ndarray:
+    """CCSDS calendar strings of datetime64[ns] (milliseconds when that is exact, else ns)."""
+    epochs = np.asarray(epochs, "datetime64[ns]")
+    exact_ms = np.all(epochs.astype(np.int64) % 1_000_000 == 0)
+    return np.datetime_as_string(epochs, unit="ms" if exact_ms else "ns")
+
+
+@lru_cache(maxsize=1)
+def _leap_table() -> tuple[np.ndarray, np.ndarray]:
+    """(UTC instants of each TAI-UTC step as datetime64[ns], TAI-UTC in s) from Leap_Second.dat."""
+    spec = importlib.util.find_spec("astropy_iers_data")
+    if spec is None or not spec.submodule_search_locations:
+        raise LookupError("the astropy_iers_data package (leap-second table) is not installed")
+    path = Path(list(spec.submodule_search_locations)[0]) / "data" / "Leap_Second.dat"
+    rows = np.loadtxt(path, comments="#")
+    mjd, step = rows[:, 0], rows[:, 4]
+    start = (np.datetime64("1858-11-17", "ns") + (mjd * 86400e9).astype("timedelta64[ns]"))
+    return start, step
+
+
+def _tai_minus_utc_at_utc(utc: np.ndarray) -> np.ndarray:
+    start, step = _leap_table()
+    i = np.searchsorted(start, utc, side="right") - 1
+    return np.where(i >= 0, step[np.clip(i, 0, None)], np.nan)
+
+
+def to_utc(epochs: np.ndarray, scale: str) -> np.ndarray:
+    """UTC of epochs given in TAI, GPS or TT (others are returned unchanged)."""
+    if scale not in LEAP_SCALES:
+        return epochs
+    tai = epochs - np.timedelta64(int(round(_FROM_TAI[scale] * 1e9)), "ns")
+    guess = tai - (_tai_minus_utc_at_utc(tai) * 1e9).astype("timedelta64[ns]")
+    return tai - (_tai_minus_utc_at_utc(guess) * 1e9).astype("timedelta64[ns]")
+
+
+def from_utc(epochs: np.ndarray, scale: str) -> np.ndarray:
+    """Epochs in ``scale`` (TAI, GPS or TT) of UTC epochs (others unchanged)."""
+    if scale not in LEAP_SCALES:
+        return epochs
+    tai = epochs + (_tai_minus_utc_at_utc(epochs) * 1e9).astype("timedelta64[ns]")
+    return tai + np.timedelta64(int(round(_FROM_TAI[scale] * 1e9)), "ns")
