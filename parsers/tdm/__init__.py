@@ -16,7 +16,7 @@ from pathlib import Path
 
 from parsers.errors import ParseReport
 from parsers.table import TrackingData
-from parsers.tdm import kvn, xml
+from parsers.tdm import keywords, kvn, times, xml
 from parsers.tdm.message import Message, Segment
 from parsers.tdm.observations import message, tracking
 
