@@ -138,3 +138,37 @@ def default_eop() -> EOPTable:
 def eop_at(epoch_utc) -> EOPValues:
     """EOP from the default IERS tables at UTC epochs."""
     return default_eop().at(epoch_utc)
+
+
+def read_jpl_eop(path) -> EOPTable:
+    """EOP table from a JPL/DSN EOP file (``EOP=`` rows: MJD, PM x, PM y mas, TAI−UT1 s, TAI−UTC s, dPsi, dEps mas).
+
+    The file's dPsi/dEps are offsets from the IAU 1980 nutation and do not apply to
+    IAU 2006/2000A, so dX = dY = 0 here. LOD is the central difference of UT1.
+    """
+    path = Path(path)
+    rows = []
+    in_data = False
+    for lineno, line in enumerate(path.read_text().splitlines(), start=1):
+        body = line.split("$", 1)[0].strip()
+        if body.startswith("EOP="):
+            in_data = True
+            body = body[4:].strip()
+        if not in_data or not body:
+            continue
+        fields = [f for f in body.split(",") if f.strip()]
+        if len(fields) != 7:
+            raise ValueError(f"{path}:{lineno}: expected 7 comma-separated EOP fields, got {len(fields)}: {line!r}")
+        try:
+            rows.append([float(f) for f in fields])
+        except ValueError as err:
+            raise ValueError(f"{path}:{lineno}: non-numeric EOP field in {line!r}") from err
+    if not rows:
+        raise ValueError(f"{path}: no 'EOP=' data rows")
+    a = np.array(rows)
+    ut1_utc = a[:, 4] - a[:, 3]
+    ut1_tai = -a[:, 3]
+    lod = -np.gradient(ut1_tai, a[:, 0])  # s of excess length per day
+    zero = np.zeros(len(a))
+    mas = 1e-3 * ARCSEC
+    return EOPTable.from_columns(a[:, 0], ut1_utc, a[:, 1] * mas, a[:, 2] * mas, zero, zero, lod, str(path))

@@ -30,12 +30,14 @@ _CIP_GRID_MIN_EPOCHS = 200
 
 @dataclass(frozen=True)
 class EarthRotation:
-    """The three factors of GCRS→ITRS: ``rpom @ R3(era) @ rc2i``, plus Earth's rotation rate (rad/s)."""
+    """The three factors of GCRS→ITRS: ``rpom @ R3(era) @ rc2i``, Earth's rotation rate ``omega`` (rad/s)
+    and, when asked for, the time derivative of ``rc2i`` (1/s, precession-nutation)."""
 
     rc2i: np.ndarray
     era: np.ndarray
     rpom: np.ndarray
     omega: np.ndarray
+    rc2i_rate: np.ndarray | None = None
 
     @property
     def gcrs_to_itrs(self) -> np.ndarray:
@@ -62,19 +64,34 @@ def cip_xys(tt_days) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     return v[..., 0], v[..., 1], v[..., 2]
 
 
-def earth_rotation(t, eop: EOPValues | None = None) -> EarthRotation:
-    """Factors of the GCRS→ITRS rotation at epochs ``t`` (EOP interpolated unless given)."""
+def _rc2i(tt_days, dx, dy) -> np.ndarray:
+    x, y, s = cip_xys(tt_days)
+    x = x + dx
+    y = y + dy
+    s = erfa.s06(J2000_JD, tt_days, x, y) if np.size(tt_days) < _CIP_GRID_MIN_EPOCHS else s
+    return erfa.c2ixys(x, y, s)
+
+
+_RATE_STEP_DAYS = 1.0 / 24.0  # central difference over ±1 h: rate error < 1e-3 relative (shortest terms ~5 d)
+
+
+def earth_rotation(t, eop: EOPValues | None = None, with_rate: bool = False) -> EarthRotation:
+    """Factors of the GCRS→ITRS rotation at epochs ``t`` (EOP interpolated unless given).
+
+    ``with_rate`` adds the precession-nutation rate of ``rc2i`` (≈5e-5 m/s at the
+    Earth's surface, needed for station velocities at Doppler precision).
+    """
     utc, tt_days = utc_and_tt(t)
     e = eop if eop is not None else eop_at(utc.astype("datetime64[ns]"))
-    x, y, s = cip_xys(tt_days)
-    x = x + e.dx
-    y = y + e.dy
-    s = erfa.s06(J2000_JD, tt_days, x, y) if np.size(tt_days) < _CIP_GRID_MIN_EPOCHS else s
-    rc2i = erfa.c2ixys(x, y, s)
+    rc2i = _rc2i(tt_days, e.dx, e.dy)
+    rate = None
+    if with_rate:
+        h = _RATE_STEP_DAYS
+        rate = (_rc2i(tt_days + h, e.dx, e.dy) - _rc2i(tt_days - h, e.dx, e.dy)) / (2 * h * 86400.0)
     days, rem_ns = np.divmod(utc - J2000_NS, NS_PER_DAY)  # whole + fraction keeps ERA at 1e-16 rad
     era = erfa.era00(J2000_JD + days, rem_ns / NS_PER_DAY + e.ut1_utc / 86400.0)
     rpom = erfa.pom00(e.xp, e.yp, erfa.sp00(J2000_JD, tt_days))
-    return EarthRotation(rc2i, era, rpom, ERA_RATE * (1.0 - e.lod / 86400.0))
+    return EarthRotation(rc2i, era, rpom, ERA_RATE * (1.0 - e.lod / 86400.0), rate)
 
 
 def gcrs_to_itrs(t, eop: EOPValues | None = None) -> np.ndarray:
@@ -110,25 +127,29 @@ def itrs_to_gcrs_state(t, r_itrs, v_itrs=None, eop: EOPValues | None = None):
     """GCRS position (m) and velocity (m/s) of ITRS positions/velocities at epochs ``t``.
 
     The velocity includes Earth rotation, ω × r with ω = ERA rate·(1 − LOD/86400)
-    about the CIP (precession-nutation and polar-motion rates are neglected:
-    < 1e-11 relative). ``v_itrs`` defaults to zero (a point fixed on the Earth).
+    about the CIP, and the precession-nutation rate; the polar-motion rate
+    (< 1e-6 m/s at the surface) is neglected. ``v_itrs`` defaults to zero (a
+    point fixed on the Earth).
     """
-    rot = earth_rotation(t, eop)
+    rot = earth_rotation(t, eop, with_rate=True)
     r = np.asarray(r_itrs, dtype=float)
     r_tirs = _mtv(rot.rpom, r)
     v_tirs = np.zeros_like(r_tirs) if v_itrs is None else _mtv(rot.rpom, np.asarray(v_itrs, dtype=float))
     w = np.asarray(rot.omega)[..., None]
     v_tirs = v_tirs + w * np.stack([-r_tirs[..., 1], r_tirs[..., 0], np.zeros_like(r_tirs[..., 0])], axis=-1)
-    c2t_no_pm = _rz(rot.era) @ rot.rc2i
-    return _mtv(c2t_no_pm, r_tirs), _mtv(c2t_no_pm, v_tirs)
+    rz = _rz(rot.era)
+    r_cirs = _mtv(rz, r_tirs)
+    return _mtv(rot.rc2i, r_cirs), _mtv(rot.rc2i, _mtv(rz, v_tirs)) + _mtv(rot.rc2i_rate, r_cirs)
 
 
 def gcrs_to_itrs_state(t, r_gcrs, v_gcrs=None, eop: EOPValues | None = None):
     """ITRS position (m) and velocity (m/s) from GCRS position/velocity at epochs ``t``."""
-    rot = earth_rotation(t, eop)
-    c2t_no_pm = _rz(rot.era) @ rot.rc2i
-    r_tirs = _mv(c2t_no_pm, np.asarray(r_gcrs, dtype=float))
-    v_tirs = np.zeros_like(r_tirs) if v_gcrs is None else _mv(c2t_no_pm, np.asarray(v_gcrs, dtype=float))
+    rot = earth_rotation(t, eop, with_rate=True)
+    rz = _rz(rot.era)
+    r = np.asarray(r_gcrs, dtype=float)
+    v_cirs = _mv(rot.rc2i_rate, r) + (0.0 if v_gcrs is None else _mv(rot.rc2i, np.asarray(v_gcrs, dtype=float)))
+    r_tirs = _mv(rz, _mv(rot.rc2i, r))
+    v_tirs = _mv(rz, v_cirs)
     w = np.asarray(rot.omega)[..., None]
     v_tirs = v_tirs - w * np.stack([-r_tirs[..., 1], r_tirs[..., 0], np.zeros_like(r_tirs[..., 0])], axis=-1)
     return _mv(rot.rpom, r_tirs), _mv(rot.rpom, v_tirs)

@@ -60,8 +60,9 @@ def tai_minus_utc_ns(utc_ns: np.ndarray) -> np.ndarray:
 def utc_ns_from_tai_ns(tai_ns: np.ndarray) -> np.ndarray:
     """UTC (int64 ns since 1970) from TAI (int64 ns on the same calendar origin).
 
-    A TAI instant inside an inserted leap second (23:59:60 UTC) maps onto the
-    first second of the following UTC day; datetime64 cannot hold second 60.
+    datetime64 cannot hold second 60: a TAI instant inside an inserted leap
+    second (23:59:60.x UTC) maps to 00:00:00 of the next UTC day, so the map
+    stays monotonic and instants next to the leap second keep their ns.
     """
     steps, dat = leap_second_table()
     steps_tai = steps + dat * NS_PER_S
@@ -69,4 +70,5 @@ def utc_ns_from_tai_ns(tai_ns: np.ndarray) -> np.ndarray:
     bad = idx < 0
     if np.any(bad):
         raise _first_error(tai_ns, bad, "TAI epoch")
-    return tai_ns - dat[idx] * NS_PER_S
+    next_step = np.append(steps[1:], np.iinfo(np.int64).max)[idx]
+    return np.minimum(tai_ns - dat[idx] * NS_PER_S, next_step)
