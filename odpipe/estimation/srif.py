@@ -22,7 +22,7 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 import numpy as np
-from scipy.linalg import solve_triangular
+from scipy.linalg.lapack import dtrtri
 
 
 def triangularize(A: np.ndarray) -> np.ndarray:
@@ -52,7 +52,9 @@ def solve_information(R, z, n_est, c_bar, c_sigma) -> Gaussian:
     n = R.shape[1]
     T = triangularize(np.column_stack([R, z]))
     Ree, Rec, ze = T[:n_est, :n_est], T[:n_est, n_est:n], T[:n_est, n]
-    Rinv = solve_triangular(Ree, np.eye(n_est))
+    Rinv, info = dtrtri(Ree)
+    if info != 0:
+        raise np.linalg.LinAlgError("singular square-root information matrix")
     S = Rinv @ Rec                          # -d(x_e)/d(c)
     x = np.concatenate([Rinv @ (ze - Rec @ c_bar), c_bar])
     Pcc = np.diag(c_sigma**2)

@@ -1,0 +1,232 @@
+"""Small self-contained problems for testing and benchmarking the estimation core.
+
+These are NOT the product's dynamics or measurement models (see
+``odpipe.dynamics`` / ``odpipe.measurements``); they satisfy the
+:class:`~odpipe.estimation.fit.Problem` protocol with the fewest assumptions:
+
+* :class:`LinearProblem` -- nilpotent linear dynamics ``dx/dt = A x`` with
+  linear observations (exact linearization, for Monte Carlo statistics);
+* :class:`TwoBodyProblem` -- one spacecraft in two-body motion with Gauss-Markov
+  accelerations (inertial axes), impulsive maneuvers, ground-station range /
+  range-rate with per-station range biases; fixed-step RK4 of state, STM and
+  acceleration sensitivities (numba).
+* :func:`crtbp_problem` -- two spacecraft in the Earth-Moon CRTBP (rotating
+  frame, dimensional) with inter-satellite range / range-rate (LiAISON).
+"""
+
+from __future__ import annotations
+
+import numpy as np
+from numba import njit
+
+from .registry import ParameterRegistry
+
+# ---------------------------------------------------------------- linear
+
+
+class LinearProblem:
+    """``dx/dt = A x`` (A nilpotent, A^4 = 0) in registry order; rows ``z_i = H_i x(t_i)``."""
+
+    def __init__(self, registry: ParameterRegistry, A: np.ndarray, H_rows: np.ndarray,
+                 times: np.ndarray):
+        if np.any(np.linalg.matrix_power(A, 4)):
+            raise ValueError("A must be nilpotent of order <= 4")
+        self.registry, self.A, self.H_rows, self.times = registry, A, H_rows, times
+        self._A2, self._A3 = A @ A, A @ A @ A
+
+    def phi(self, dt):
+        """Transition matrices for an array of dt: (len(dt), n, n)."""
+        dt = np.asarray(dt, float)[..., None, None]
+        n = self.A.shape[0]
+        return np.eye(n) + self.A * dt + self._A2 * dt**2 / 2 + self._A3 * dt**3 / 6
+
+    def transition(self, t0, t1, x0):
+        Phi = self.phi(t1 - t0)
+        return Phi @ x0, Phi
+
+    def predict(self, t0, x0, rows):
+        H = np.einsum("mj,mjk->mk", self.H_rows[rows], self.phi(self.times[rows] - t0))
+        return H @ x0, H
+
+
+# ---------------------------------------------------------------- integration
+
+
+@njit(cache=True)
+def _twobody_deriv(y, p, out):
+    """y = [r, v, S(6 x k) row-major]; p = [mu, ax, ay, az]; S columns: x0 then acc."""
+    r = y[0:3]
+    rn = np.sqrt(r[0] ** 2 + r[1] ** 2 + r[2] ** 2)
+    mu = p[0]
+    out[0:3] = y[3:6]
+    out[3:6] = -mu * r / rn**3 + p[1:4]
+    G = np.empty((3, 3))
+    for i in range(3):
+        for j in range(3):
+            G[i, j] = 3 * mu * r[i] * r[j] / rn**5 - (mu / rn**3 if i == j else 0.0)
+    _variational(y, G, np.zeros((3, 3)), out)
+
+
+@njit(cache=True)
+def _crtbp_deriv(y, p, out):
+    """Rotating-frame CRTBP; p = [mu1, mu2, L, omega, ax, ay, az] (SI)."""
+    mu1, mu2, L, w = p[0], p[1], p[2], p[3]
+    mu = mu2 / (mu1 + mu2)
+    r = y[0:3]
+    v = y[3:6]
+    d1 = r.copy()
+    d1[0] += mu * L
+    d2 = r.copy()
+    d2[0] -= (1 - mu) * L
+    n1 = np.sqrt(d1 @ d1)
+    n2 = np.sqrt(d2 @ d2)
+    out[0:3] = v
+    out[3:6] = -mu1 * d1 / n1**3 - mu2 * d2 / n2**3 + p[4:7]
+    out[3] += w * w * r[0] + 2 * w * v[1]
+    out[4] += w * w * r[1] - 2 * w * v[0]
+    G = np.empty((3, 3))
+    for i in range(3):
+        for j in range(3):
+            G[i, j] = (3 * mu1 * d1[i] * d1[j] / n1**5 + 3 * mu2 * d2[i] * d2[j] / n2**5
+                       - (mu1 / n1**3 + mu2 / n2**3 if i == j else 0.0))
+    G[0, 0] += w * w
+    G[1, 1] += w * w
+    C = np.zeros((3, 3))
+    C[0, 1] = 2 * w
+    C[1, 0] = -2 * w
+    _variational(y, G, C, out)
+
+
+@njit(cache=True)
+def _variational(y, G, C, out):
+    """d/dt S = [[0, I], [G, C]] S + [0; I] on the acceleration columns (last three)."""
+    k = (y.size - 6) // 6
+    S = y[6:].reshape(6, k)
+    D = np.zeros((6, k))
+    D[0:3] = S[3:6]
+    D[3:6] = G @ S[0:3] + C @ S[3:6]
+    for i in range(3):
+        D[3 + i, k - 3 + i] += 1.0
+    out[6:] = D.ravel()
+
+
+@njit(cache=True)
+def _rk4(deriv, y0, t0, times, h, p):
+    """Fixed-step RK4 from t0 through sorted ``times`` (>= t0); returns states at times."""
+    out = np.empty((times.size, y0.size))
+    y = y0.copy()
+    t = t0
+    k1, k2, k3, k4 = (np.empty_like(y0) for _ in range(4))
+    for i in range(times.size):
+        while t < times[i]:
+            dt = min(h, times[i] - t)
+            deriv(y, p, k1)
+            deriv(y + 0.5 * dt * k1, p, k2)
+            deriv(y + 0.5 * dt * k2, p, k3)
+            deriv(y + dt * k3, p, k4)
+            y = y + dt / 6 * (k1 + 2 * k2 + 2 * k3 + k4)
+            t += dt
+        out[i] = y
+    return out
+
+
+def flow(deriv, p_const, x0, acc, t0, times, h):
+    """States (m, 6) and sensitivities (m, 6, 9) to [x0, acc] at ``times``."""
+    y0 = np.concatenate([x0, np.hstack([np.eye(6), np.zeros((6, 3))]).ravel()])
+    Y = _rk4(deriv, y0, float(t0), np.asarray(times, float), h,
+             np.concatenate([p_const, acc]))
+    return Y[:, :6], Y[:, 6:].reshape(-1, 6, 9)
+
+
+# ---------------------------------------------------------------- two-body
+
+MU_EARTH = 3.986004415e14   # m^3/s^2
+OMEGA_EARTH = 7.292115e-5   # rad/s
+R_EARTH = 6378137.0         # m
+
+
+def station_states(lat_lon, t):
+    """Inertial position/velocity (m, m/s) of stations on a uniformly rotating Earth."""
+    lat, lon = np.radians(np.asarray(lat_lon, float)).T
+    th = lon[:, None] + OMEGA_EARTH * np.asarray(t)[None, :]
+    c = np.cos(lat)[:, None]
+    r = R_EARTH * np.stack([c * np.cos(th), c * np.sin(th), np.sin(lat)[:, None] + 0 * th], -1)
+    v = R_EARTH * OMEGA_EARTH * np.stack([-c * np.sin(th), c * np.cos(th), 0 * th], -1)
+    return r, v
+
+
+class TwoBodyProblem:
+    """One spacecraft ``sc``: registry [state(6), acc(3), maneuvers..., range biases...].
+
+    rows: per observation the station index and kind (0 range m, 1 range-rate m/s).
+    """
+
+    def __init__(self, registry, times, station, kind, stations_lat_lon, h=10.0):
+        self.registry, self.times = registry, np.asarray(times, float)
+        self.station, self.kind = np.asarray(station), np.asarray(kind)
+        self.stations = np.asarray(stations_lat_lon, float)
+        self.h = h
+        self.i_state = registry.slice("state", "sc")
+        self.i_acc = registry.slice("stochastic", "sc")
+        self.maneuvers = {}
+        for p in registry.parameters:
+            if p.kind == "maneuver":
+                self.maneuvers.setdefault(p.epoch, []).append(registry.index(p.name))
+        self.i_bias = np.array([registry.index(f"bias.range.{s}") for s in range(len(self.stations))])
+
+    def _start(self, t0, x0):
+        """State right after t0 (maneuver applied) and d(state)/d(dV) columns."""
+        s = x0[self.i_state].copy()
+        dv_idx = self.maneuvers.get(float(t0), [])
+        if dv_idx:
+            s[3:6] += x0[dv_idx]
+        return s, dv_idx
+
+    def _registry_sens(self, S, dv_idx, m):
+        n = len(self.registry)
+        D = np.zeros((m, 6, n))
+        D[:, :, self.i_state] = S[:, :, :6]
+        D[:, :, self.i_acc] = S[:, :, 6:]
+        if dv_idx:
+            D[:, :, dv_idx] = S[:, :, 3:6]
+        return D
+
+    def transition(self, t0, t1, x0):
+        s, dv_idx = self._start(t0, x0)
+        X, S = flow(_twobody_deriv, np.array([MU_EARTH]), s, x0[self.i_acc], t0, [t1], self.h)
+        Phi = np.eye(len(self.registry))
+        Phi[self.i_state] = self._registry_sens(S, dv_idx, 1)[0]
+        x1 = x0.copy()
+        x1[self.i_state] = X[0]
+        return x1, Phi
+
+    def predict(self, t0, x0, rows):
+        s, dv_idx = self._start(t0, x0)
+        t = self.times[rows]
+        X, S = flow(_twobody_deriv, np.array([MU_EARTH]), s, x0[self.i_acc], t0, t, self.h)
+        D = self._registry_sens(S, dv_idx, rows.size)
+        st = self.station[rows]
+        rs, vs = station_states(self.stations, t)
+        m = np.arange(rows.size)
+        z, dz = range_and_rate(X, rs[st, m], vs[st, m], self.kind[rows])
+        H = np.einsum("mj,mjk->mk", dz, D)
+        isr = self.kind[rows] == 0
+        z[isr] += x0[self.i_bias[st[isr]]]
+        H[np.flatnonzero(isr), self.i_bias[st[isr]]] += 1.0
+        return z, H
+
+
+def range_and_rate(X, r_other, v_other, kind):
+    """Range (kind 0) or range-rate (kind 1) from X (m, 6) to another body, with d/dX."""
+    dr = X[:, :3] - r_other
+    dv = X[:, 3:] - v_other
+    rho = np.linalg.norm(dr, axis=1)
+    u = dr / rho[:, None]
+    rr = np.sum(u * dv, axis=1)
+    dz = np.zeros((X.shape[0], 6))
+    israte = kind == 1
+    dz[~israte, :3] = u[~israte]
+    du = (dv - rr[:, None] * u) / rho[:, None]
+    dz[israte, :3] = du[israte]
+    dz[israte, 3:] = u[israte]
+    return np.where(israte, rr, rho), dz
