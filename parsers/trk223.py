@@ -221,7 +221,10 @@ class CalibrationSet:
         ti = ts.view("int64")
         value = np.zeros(t.size)
         used = np.full(t.size, -1, dtype=np.int64)
-        scid = None if spacecraft is None else int(str(spacecraft).strip())
+        try:
+            scid = None if spacecraft is None else int(str(spacecraft).strip())
+        except ValueError:
+            scid = -2   # not a DSN spacecraft id: only cards without SCID apply
         for k, c in enumerate(self.cards):
             if c.model != model or kind not in c.data_types or not _covers(c.network, station):
                 continue

@@ -6,7 +6,6 @@ import numpy as np
 import pytest
 
 from odpipe.media import niell, saastamoinen
-from odpipe.media.geometry import azimuth_elevation, geodetic
 from odpipe.media.ionosphere import IonexModel, group_delay, pierce_point
 from odpipe.media.seasonal import dsn_seasonal
 from parsers.ionex import read_ionex
@@ -61,18 +60,6 @@ def test_dsn_seasonal_model_values():
     jan, jul = np.array(["2006-01-15", "2006-07-15"], dtype="datetime64[ns]")
     assert cs.zenith_delay("DSS-25", jul, "wet")[0] > cs.zenith_delay("DSS-25", jan, "wet")[0]
     assert cs.zenith_delay("DSS-34", jan, "wet")[0] > cs.zenith_delay("DSS-34", jul, "wet")[0]
-
-
-def test_geodetic_and_elevation_of_a_dsn_antenna():
-    # DSS-14 ITRF93 (810-005 301 Rev M): geodetic 35.4259 N, 243.1105 E, 1002.1 m (same table)
-    r = np.array([-2353621.420, -4641341.472, 3677052.318])
-    lat, lon, h = geodetic(r)
-    assert np.degrees(lat) == pytest.approx(35.42590, abs=2e-4)
-    assert np.degrees(lon) % 360 == pytest.approx(243.11047, abs=2e-4)
-    assert h == pytest.approx(1002.1, abs=1.0)
-    up = r + 1e7 * np.array([np.cos(lat) * np.cos(lon), np.cos(lat) * np.sin(lon), np.sin(lat)])
-    az, el = azimuth_elevation(r, up)
-    assert el == pytest.approx(np.pi / 2, abs=1e-9)
 
 
 @pytest.fixture(scope="module")

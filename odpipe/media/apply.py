@@ -1,0 +1,215 @@
+"""Media corrections of a TrackingTable, leg by leg, at each leg's own time and frequency.
+
+For every row the downlink leg is evaluated at the receiving station at
+reception, and (two- and three-way data) the uplink leg at the transmitting
+station at ``reception - round-trip light time``. Range rows get the summed
+group delays of their legs; Doppler rows (count-averaged) get the change of
+the summed phase delays over the count interval, end minus start — not the
+delay itself. Columns added:
+
+- ``tropo_m``, ``iono_m``, ``media_m`` (sum): m of path delay (range rows),
+  m of delay change over the count interval (Doppler rows; the range-rate
+  equivalent is ``media_m / count_time``). Subtract from the observable.
+- ``media_ru``: ``media_m`` of range rows in range units (NaN when the
+  uplink frequency is not known at the row, e.g. ramped).
+- ``media_source`` / ``media_source_up``: which file and card (or model)
+  gave the downlink / uplink values; ``media_note``: why a fallback was used.
+
+The spacecraft direction comes from ``target_itrs(t_utc) -> (N, 3)`` m
+(apparent position seen from the ground at ground time), or from the
+table's ``elevation_rx``/``azimuth_rx`` columns (rad), interpolated in time
+per station. The round-trip light time comes from a ``rtlt_s`` column, else
+from ``target_itrs`` (twice the station-spacecraft distance over c), else it
+is taken as 0 and the note says so.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+import pandas as pd
+
+from odpipe.environment.stations import StationCatalog, itrs_to_geodetic, topocentric
+from odpipe.measurements.bands import C_LIGHT, range_unit_factor
+from odpipe.media.model import MediaModel
+from odpipe.media.smoothing import smooth_by_group
+from odpipe.preprocess.passes import assign_passes
+from odpipe.preprocess.timetags import interval_bounds
+
+# nominal DSN sky frequencies (Hz) when a row has no usable frequency
+NOMINAL_HZ = {("up", "S"): 2.115e9, ("up", "X"): 7.16e9, ("up", "KA"): 34.3e9,
+              ("down", "S"): 2.295e9, ("down", "X"): 8.42e9, ("down", "KA"): 32.05e9}
+TWO_LEG = ("range", "doppler_2way", "doppler_3way")
+GROUND = TWO_LEG + ("doppler_1way",)
+
+
+def calibrate(table: pd.DataFrame, model: MediaModel, *, target_itrs=None,
+              catalog: StationCatalog | None = None, order: int | None = 10):
+    """(table with media columns, per-pass coverage report); ``order=None`` disables smoothing."""
+    catalog = catalog or StationCatalog.default()
+    out = table.copy()
+    if (out["pass_id"] < 0).all() and len(out):
+        out = assign_passes(out)
+    n = len(out)
+    obs = out["observable"].to_numpy(dtype=object)
+    ground = np.isin(obs, GROUND)
+    doppler = np.char.startswith(obs.astype(str), "doppler")
+    epoch = out["epoch"].to_numpy().astype("datetime64[ns]").view(np.int64)
+    ct = np.where(doppler, out["count_time"].to_numpy(dtype=float), 0.0)
+    start, end = interval_bounds(epoch, ct, out["tag"].to_numpy())
+    rtlt, rtlt_note = _round_trip(out, target_itrs, catalog, epoch)
+
+    samples = []      # (row, leg, instant sign, station, ground time ns, frequency Hz)
+    f_up, f_down = _frequencies(out)
+    for leg, stations, freq, legs_rows in (("down", out["station_rx"], f_down, ground),
+                                           ("up", out["station_tx"], f_up, ground & np.isin(obs, TWO_LEG))):
+        delay_ns = np.rint(rtlt * 1e9).astype(np.int64) if leg == "up" else 0
+        for sign, t in ((1.0, np.where(doppler, end, epoch)), (-1.0, start)):
+            rows = np.flatnonzero(legs_rows & ((sign > 0) | doppler))
+            samples.append(pd.DataFrame({
+                "row": rows, "leg": leg, "sign": sign, "station": stations.to_numpy(dtype=object)[rows],
+                "t": (t - delay_ns)[rows],
+                "f": freq[rows]}))
+    s = pd.concat(samples, ignore_index=True)
+    s["phase"] = doppler[s["row"].to_numpy()]
+    s["pass_id"] = out["pass_id"].to_numpy()[s["row"].to_numpy()]
+    s["spacecraft"] = out["spacecraft"].to_numpy(dtype=object)[s["row"].to_numpy()]
+    tropo, iono, lab_t, lab_i = _leg_delays(s, out, model, target_itrs, catalog)
+    if order is not None and len(s):
+        group = pd.MultiIndex.from_arrays([s["pass_id"], s["leg"], s["station"]]).codes
+        key = np.ravel_multi_index(group, [len(c) + 1 for c in group])
+        tsec = (s["t"].to_numpy() - s["t"].to_numpy().min()) * 1e-9
+        tropo = smooth_by_group(tsec, tropo, key, order)
+        iono = smooth_by_group(tsec, iono, key, order)
+    iono = np.where(s["phase"].to_numpy(), -iono, iono)
+    rows, sign = s["row"].to_numpy(), s["sign"].to_numpy()
+    out["tropo_m"] = _row_sum(n, rows, sign * tropo, ground)
+    out["iono_m"] = _row_sum(n, rows, sign * iono, ground)
+    out["media_m"] = out["tropo_m"] + out["iono_m"]
+    is_range = obs == "range"
+    f_ru = out["uplink_hz"].to_numpy(dtype=float) * range_unit_factor(out["band_up"].to_numpy())
+    out["media_ru"] = np.where(is_range, out["media_m"].to_numpy() / C_LIGHT * f_ru, np.nan)
+    text = "tropo: " + lab_t + " | iono: " + lab_i
+    first = (sign > 0)
+    for leg, col in (("down", "media_source"), ("up", "media_source_up")):
+        pick = first & (s["leg"].to_numpy() == leg)
+        labels = np.full(n, "", dtype=object)
+        labels[rows[pick]] = text[pick]
+        out[col] = labels
+    out["media_note"] = _notes(n, rows, text.astype(str), ground, np.isin(obs, TWO_LEG), rtlt_note)
+    return out, pass_report(out)
+
+
+def _frequencies(t: pd.DataFrame):
+    """(uplink Hz, downlink Hz) per row: table values, turnaround, else nominal band frequency."""
+    up = t["uplink_hz"].to_numpy(dtype=float)
+    nominal_up = np.array([NOMINAL_HZ.get(("up", str(b).upper()), np.nan) for b in t["band_up"]])
+    nominal_dn = np.array([NOMINAL_HZ.get(("down", str(b).upper()), np.nan) for b in t["band_down"]])
+    f_up = np.where(np.isfinite(up), up, nominal_up)
+    one_way = t["observable"].to_numpy(dtype=object) == "doppler_1way"
+    turned = f_up * t["transponder_ratio"].to_numpy(dtype=float)
+    f_down = np.where(one_way & np.isfinite(up), up, np.where(np.isfinite(turned), turned, nominal_dn))
+    return f_up, f_down
+
+
+def _round_trip(t: pd.DataFrame, target_itrs, catalog, epoch_ns):
+    """(round-trip light time s per row, note) from a column, the target, or 0."""
+    if "rtlt_s" in t.columns:
+        return t["rtlt_s"].to_numpy(dtype=float), ""
+    if target_itrs is None:
+        return np.zeros(len(t)), "uplink at reception time (no light time known)"
+    rtlt = np.zeros(len(t))
+    times = epoch_ns.view("datetime64[ns]")
+    for name, idx in t.groupby("station_rx").indices.items():
+        if name in catalog:
+            st = catalog[name]
+            rtlt[idx] = 2.0 * np.linalg.norm(np.asarray(target_itrs(times[idx])) - st.position_itrs(times[idx]),
+                                             axis=-1) / C_LIGHT
+    return rtlt, ""
+
+
+def _leg_delays(s: pd.DataFrame, table, model: MediaModel, target_itrs, catalog):
+    """Group delays (troposphere, ionosphere, m) and their source labels per sample."""
+    m = len(s)
+    tropo, iono = np.full(m, np.nan), np.full(m, np.nan)
+    lab_t = np.full(m, "no station", dtype=object)
+    lab_i = lab_t.copy()
+    t_all = s["t"].to_numpy().view("datetime64[ns]")
+    for name, idx in s.groupby("station").indices.items():
+        if name not in catalog:
+            continue
+        st = catalog[name]
+        lat, lon, h = itrs_to_geodetic(st.r_itrs)
+        t = t_all[idx]
+        az, el = _direction(name, t, table, target_itrs, st)
+        bad = ~(el > 0.0)        # no direction, or below the horizon
+        el_ok = np.where(bad, np.pi / 2, el)
+        az_ok = np.where(bad, 0.0, az)
+        d_t, l_t = model.troposphere(name, t, el_ok, lat, h)
+        for sc, sub in pd.Series(np.arange(idx.size)).groupby(s["spacecraft"].to_numpy()[idx]).indices.items():
+            d_i, l_i = model.ionosphere(name, sc, t[sub], el_ok[sub], az_ok[sub], lat, lon, s["f"].to_numpy()[idx][sub])
+            iono[idx[sub]] = np.where(bad[sub], np.nan, d_i)
+            lab_i[idx[sub]] = np.where(bad[sub], "no direction", l_i)
+        tropo[idx] = np.where(bad, np.nan, d_t)
+        lab_t[idx] = np.where(bad, "no direction", l_t)
+    return tropo, iono, lab_t, lab_i
+
+
+def _direction(station, t, table, target_itrs, st):
+    """(azimuth, elevation) rad at a station at UTC times from the target or the table's columns."""
+    if target_itrs is not None:
+        az, el, _ = topocentric(st, np.asarray(target_itrs(t)), t)
+        return az, el
+    if "elevation_rx" not in table.columns:
+        return np.full(t.size, np.nan), np.full(t.size, np.nan)
+    rows = table[table["station_rx"] == station]
+    tt = rows["epoch"].to_numpy().astype("datetime64[ns]").view(np.int64).astype(float)
+    order = np.argsort(tt)
+    tt, el = tt[order], rows["elevation_rx"].to_numpy(dtype=float)[order]
+    az = np.unwrap(rows["azimuth_rx"].to_numpy(dtype=float)[order]) if "azimuth_rx" in rows else np.zeros(tt.size)
+    x = t.view(np.int64).astype(float)
+    if tt.size == 0:
+        return np.full(t.size, np.nan), np.full(t.size, np.nan)
+    inside = (x >= tt[0]) & (x <= tt[-1])
+    return (np.mod(np.interp(x, tt, az), 2 * np.pi),
+            np.where(inside, np.interp(x, tt, el), np.nan))
+
+
+def _row_sum(n, rows, values, ground):
+    out = np.zeros(n)
+    np.add.at(out, rows, values)
+    bad = np.zeros(n, dtype=bool)
+    np.logical_or.at(bad, rows, ~np.isfinite(values))
+    return np.where(ground & ~bad, out, np.nan)
+
+
+def _notes(n, rows, sample_labels, ground, two_leg, rtlt_note):
+    """Per row: why its correction is partial or a fallback (from every sample's source labels)."""
+    reasons = [(np.char.find(sample_labels, flag) >= 0, text) for flag, text in (
+        ("(no TRO)", "no TRO coverage: DSN seasonal model used"),
+        ("standard-atmosphere", "non-DSN station: standard atmosphere used"),
+        ("iono: none", "no ionosphere calibration: none applied"),
+        ("no direction", "no spacecraft direction or below horizon: no correction"),
+        ("no station", "station not in catalog: no correction"))]
+    notes = []
+    for hit, text in reasons:
+        row_hit = np.zeros(n, dtype=bool)
+        np.logical_or.at(row_hit, rows, hit)
+        notes.append(np.where(row_hit, text, ""))
+    if rtlt_note:
+        notes.append(np.where(two_leg, rtlt_note, ""))
+    notes.append(np.where(ground, "", "not a ground radiometric observable: no correction"))
+    return np.array(["; ".join(p for p in parts if p) for parts in zip(*notes)], dtype=object)
+
+
+def pass_report(t: pd.DataFrame) -> pd.DataFrame:
+    """Per pass: station, rows, time span, sources used, and notes (fallbacks and their reasons)."""
+    g = t.groupby("pass_id", sort=True)
+    return pd.DataFrame({
+        "station_rx": g["station_rx"].first(),
+        "observable": g["observable"].first(),
+        "rows": g.size(),
+        "start": g["epoch"].min(),
+        "end": g["epoch"].max(),
+        "sources": g["media_source"].agg(lambda x: " || ".join(sorted(set(x)))),
+        "notes": g["media_note"].agg(lambda x: "; ".join(sorted({p for v in x for p in v.split("; ") if p}))),
+    }).reset_index()
