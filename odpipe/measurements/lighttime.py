@@ -101,7 +101,9 @@ class PathSolution:
     epochs (N,k+1) s TDB as evaluated, epoch_corr (N,k+1) s to add for the exact
     event epoch; states (N,k+1,6) at the exact events (solve frame);
     leg_time (N,k) s TDB including Shapiro; shapiro (N,k) s; clock (N,k+1) s:
-    TDB minus each node's clock at its event; dlt_dr (N,k+1,3) s/m (see module doc).
+    TDB minus each node's clock at its event; dlt_dr (N,k+1,3) s/m (see module doc);
+    rate (N,): d(total light time)/d(anchor epoch), dimensionless (the limit of a
+    count-averaged Doppler as the count time goes to 0, over c).
     """
 
     epochs: np.ndarray
@@ -111,6 +113,7 @@ class PathSolution:
     shapiro: np.ndarray
     clock: np.ndarray
     dlt_dr: np.ndarray
+    rate: np.ndarray
 
     @property
     def light_time(self) -> np.ndarray:
@@ -188,13 +191,14 @@ def solve_path(nodes: Sequence, t_anchor, anchor: str = "receive", t_corr=None,
         shapiro[:, leg] = shap
 
     clock = np.stack([nodes[i].tdb_minus_clock(epochs[:, i], states[:, i]) for i in range(k + 1)], axis=1)
-    return PathSolution(epochs, corr, states, leg_time, shapiro, clock, _chain_partials(states, anchor))
+    return PathSolution(epochs, corr, states, leg_time, shapiro, clock, *_chain_partials(states, anchor))
 
 
-def _chain_partials(states: np.ndarray, anchor: str) -> np.ndarray:
-    """d(t_last - t_first)/d(event positions), (N,k+1,3) s/m, by chaining the legs."""
+def _chain_partials(states: np.ndarray, anchor: str) -> tuple[np.ndarray, np.ndarray]:
+    """d(t_last - t_first)/d(event positions) (N,k+1,3) s/m, and d(t_last - t_first)/d(anchor), by chaining legs."""
     n, kp1, _ = states.shape
     g = np.zeros((n, kp1, kp1, 3))  # g[:, j] = gradient of event j's epoch
+    dt = np.ones(n)  # d(current epoch)/d(anchor epoch)
     legs = range(kp1 - 1, 0, -1) if anchor == "receive" else range(1, kp1)
     for j in legs:
         r_rx, v_rx = states[:, j, :3], states[:, j, 3:]
@@ -209,8 +213,22 @@ def _chain_partials(states: np.ndarray, anchor: str) -> np.ndarray:
             g[:, j - 1] = (1.0 - b)[:, None, None] * g[:, j]
             g[:, j - 1, j] -= a
             g[:, j - 1, j - 1] += a
+            dt = dt * (1.0 - b)
         else:  # dt_j = (1+b) dt_{j-1} + a.dr_j - a.dr_{j-1}
             g[:, j] = (1.0 + b)[:, None, None] * g[:, j - 1]
             g[:, j, j] += a
             g[:, j, j - 1] -= a
-    return -g[:, 0] if anchor == "receive" else g[:, -1]
+            dt = dt * (1.0 + b)
+    if anchor == "receive":
+        return -g[:, 0], 1.0 - dt
+    return g[:, -1], dt - 1.0
+
+
+def anchor_from_utc(epoch_utc, offset_s=0.0) -> tuple[np.ndarray, np.ndarray]:
+    """UTC datetime64[ns] (+ offset s) to the (TDB s past J2000, correction s) pair :func:`solve_path` takes."""
+    from odpipe.time import utc_to_tdb2
+
+    whole, frac = utc_to_tdb2(np.atleast_1d(np.asarray(epoch_utc, dtype="datetime64[ns]")))
+    frac = frac + offset_s
+    t = whole + frac
+    return t, (whole - t) + frac

@@ -22,15 +22,14 @@ from __future__ import annotations
 from dataclasses import dataclass
 from typing import Callable, Protocol
 
-import erfa
 import numpy as np
 from scipy.interpolate import CubicSpline
+
+from odpipe.time import tdb_minus_tt
 
 from .bands import C_LIGHT
 
 EARTH_ROTATION_RATE = 7.292115146706979e-5  # rad/s, IERS nominal (used for the station velocity only)
-_J2000_JD = 2451545.0
-_DAY = 86400.0
 
 
 class Node(Protocol):
@@ -123,13 +122,12 @@ class StationNode:
 def geocentric_tdb_minus_tt(t: np.ndarray) -> np.ndarray:
     """TDB - TT at the geocentre (s) for TDB seconds past J2000.
 
-    ERFA's ``dtdb`` series evaluated on an hourly grid over the span and
-    interpolated with a cubic spline (the series has no terms shorter than
+    :func:`odpipe.time.tdb_minus_tt` (ERFA's ``dtdb`` series) evaluated on an hourly
+    grid over the span and interpolated with a cubic spline (the series has no terms shorter than
     about a day at the geocentre, so the spline error is far below 1 ns and
     its rate error below 1e-15).
     """
     t = np.atleast_1d(np.asarray(t, dtype=float))
     lo, hi = np.floor(t.min() / 3600.0) - 2, np.ceil(t.max() / 3600.0) + 3
     grid = np.arange(lo, hi + 1) * 3600.0
-    vals = erfa.dtdb(np.full(grid.size, _J2000_JD), grid / _DAY, 0.0, 0.0, 0.0, 0.0)
-    return CubicSpline(grid, vals)(t)
+    return CubicSpline(grid, tdb_minus_tt(grid))(t)

@@ -1,0 +1,48 @@
+"""Event partials composed into estimation partials: epoch state, dynamic parameters, station coordinates.
+
+For a spacecraft flying a trajectory with ``stm(t) -> (N,6,6)`` (d x(t) / d x(t0))
+and ``sensitivity(t) -> (N,6,p)`` (d x(t) / d p), the partial of an observable
+with respect to the arc's epoch state is the sum over the spacecraft's events
+of ``[d_pos, d_vel] @ stm(t_event)`` (likewise for p). For a station, the
+partial with respect to its ITRS position is ``d_pos @ R_itrs_to_icrf(t_event)``.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from .computed import Computed
+
+
+def event_gradient(computed: Computed, role: str) -> list[tuple[np.ndarray, np.ndarray]]:
+    """[(t_event (N,), d value/d state (N,6))] for every event of ``role``."""
+    out = []
+    for ev in computed.events:
+        if ev.role == role:
+            dv = np.zeros_like(ev.d_pos) if ev.d_vel is None else ev.d_vel
+            out.append((ev.t, np.concatenate([ev.d_pos, dv], axis=1)))
+    return out
+
+
+def epoch_state_partials(computed: Computed, role: str, trajectory) -> np.ndarray:
+    """d value / d (epoch state of ``trajectory``), (N,6), summing the events of ``role``."""
+    total = np.zeros((computed.value.size, 6))
+    for t, g in event_gradient(computed, role):
+        total += np.einsum("ni,nij->nj", g, np.asarray(trajectory.stm(t)).reshape(t.size, 6, 6))
+    return total
+
+
+def dynamic_partials(computed: Computed, role: str, trajectory) -> np.ndarray:
+    """d value / d (dynamic parameters of ``trajectory``), (N,p), through ``trajectory.sensitivity``."""
+    grads = event_gradient(computed, role)
+    parts = [np.einsum("ni,nip->np", g, np.asarray(trajectory.sensitivity(t))) for t, g in grads]
+    return sum(parts[1:], parts[0]) if parts else np.zeros((computed.value.size, 0))
+
+
+def station_partials(computed: Computed, role: str, station_node) -> np.ndarray:
+    """d value / d (ITRS position of the station playing ``role``), (N,3)."""
+    total = np.zeros((computed.value.size, 3))
+    for ev in computed.events:
+        if ev.role == role:
+            total += np.einsum("ni,nij->nj", ev.d_pos, station_node.itrs_to_frame(ev.t))
+    return total
