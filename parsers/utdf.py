@@ -1,0 +1,277 @@
+"""Reader and writer of GSFC Universal Tracking Data Format (UTDF, 450-ICD-SN/CUE).
+
+A UTDF file is a sequence of 75-byte big-endian records (byte numbers 1-based):
+
+    1-3 sync 0D 0A 01 · 4-5 router (ASCII) · 6 year · 7-8 SIC · 9-10 VID ·
+    11-14 seconds of year · 15-18 microseconds · 19-22 angle 1 (az or X) and
+    23-26 angle 2 (el or Y) in 2^-32 of a circle · 27-32 range delay in
+    1/256 ns (round trip) · 33-38 Doppler count (cycles of bias + M * Doppler)
+    · 39-40 AGC · 41-44 transmit frequency in 10 Hz · 45/47 transmit/receive
+    antenna type (high nybble diameter code, low nybble geometry code) ·
+    46/48 transmit/receive antenna pad id · 49-50 mode · 51 data validity
+    (bit 0 range, 1 Doppler, 2 angles, 3 angles corrected for misalignment,
+    4 angles corrected for refraction, 5 range corrected for refraction,
+    6 destruct Doppler, 7 side lobe) · 52 frequency band (high nybble) and
+    transmission type (low nybble) · 53-54 tracker type (bits 12-15), last
+    frame (bit 11), data interval (bits 0-10: seconds, or when bit 10 is set
+    the two's complement of samples per second) · 55-72 TDRSS-only fields ·
+    73-75 sync 04 0F 0F.
+
+The year byte is the year's last two digits (70-99 -> 19xx, 0-69 -> 20xx);
+values of 100 and more are read as years since 1900. The time tag is that
+year's 1 January 00:00 UTC + seconds of year + microseconds.
+
+:func:`read` gives one table row per observable a record carries (a set
+validity bit or a non-zero field): ``range`` as round-trip delay in s,
+Doppler as the Doppler shift in Hz = (delta count / delta t - 240 MHz bias) / M
+between consecutive records of one vehicle and pad (or count / interval for
+destruct Doppler; NaN for the first of a series), angles in rad. Extra
+columns keep every field; ``meta["records"]`` holds the records field by field
+and :func:`write` turns such a frame back into bytes, bit for bit.
+"""
+
+from __future__ import annotations
+
+import os
+from pathlib import Path
+
+import numpy as np
+import pandas as pd
+
+from parsers import table as tt
+from parsers.errors import ParseError, ParseReport, handle
+from parsers.table import TrackingData
+
+RECORD = 75
+FRONT, REAR = b"\x0d\x0a\x01", b"\x04\x0f\x0f"
+DOPPLER_BIAS_HZ = 240e6
+COUNT_WRAP = 1 << 48
+TWO_PI = 2 * np.pi
+
+# one 75-byte record, big-endian, packed
+DTYPE = np.dtype([
+    ("front", "S3"), ("router", "S2"), ("year", "u1"), ("sic", ">u2"), ("vid", ">u2"),
+    ("seconds_of_year", ">u4"), ("microseconds", ">u4"), ("angle1", ">u4"), ("angle2", ">u4"),
+    ("range_hi", ">u4"), ("range_lo", ">u2"), ("doppler_hi", ">u4"), ("doppler_lo", ">u2"),
+    ("agc", ">u2"), ("transmit_freq_10hz", ">u4"), ("tx_antenna_type", "u1"), ("tx_pad", "u1"),
+    ("rx_antenna_type", "u1"), ("rx_pad", "u1"), ("mode", ">u2"), ("validity", "u1"),
+    ("band_and_type", "u1"), ("tracker_and_interval", ">u2"), ("tdrss", "S18"), ("rear", "S3"),
+])
+assert DTYPE.itemsize == RECORD
+
+# the fields of meta["records"] that write() needs (hi/lo words merged into one count)
+RECORD_FIELDS = ["front", "router", "year", "sic", "vid", "seconds_of_year", "microseconds",
+                 "angle1", "angle2", "range_delay", "doppler_count", "agc", "transmit_freq_10hz",
+                 "tx_antenna_type", "tx_pad", "rx_antenna_type", "rx_pad", "mode", "validity",
+                 "band_and_type", "tracker_and_interval", "tdrss", "rear"]
+
+# frequency band code -> (uplink band, downlink band)
+BANDS = {1: ("VHF", "VHF"), 2: ("UHF", "UHF"), 3: ("S", "S"), 4: ("C", "C"), 5: ("X", "X"),
+         6: ("Ku", "Ku"), 7: ("visible", "visible"), 8: ("S", "Ku")}
+GEOMETRY = {0: ("angle_az", "angle_el"), 1: ("angle_x", "angle_y"), 2: ("angle_x", "angle_y"),
+            3: ("angle_ra", "angle_dec"), 4: ("angle_ha", "angle_dec")}
+
+
+def sniff(head: bytes) -> bool:
+    """True when ``head`` starts with a UTDF record (sync bytes at both ends)."""
+    return len(head) >= RECORD and head[:3] == FRONT and head[72:75] == REAR
+
+
+def read(path, errors: str = "raise") -> TrackingData:
+    """Read a UTDF file into a TrackingData; ``meta["records"]`` keeps every field of every record."""
+    if errors not in ("raise", "report"):
+        raise ValueError(f"errors must be 'raise' or 'report', not {errors!r}")
+    path = Path(path)
+    buf = path.read_bytes()
+    report = ParseReport()
+    n = len(buf) // RECORD
+    if len(buf) % RECORD:
+        handle(ParseError(path, f"trailing partial record of {len(buf) % RECORD} bytes",
+                          offset=n * RECORD, record=n), errors, report)
+    raw = np.frombuffer(buf, DTYPE, count=n)
+    ok = _check(path, raw, errors, report)
+    rec = records_frame(raw[ok], np.flatnonzero(ok))
+    table = _table(rec, str(path))
+    meta = {"records": rec, "sic": sorted(set(rec["sic"].tolist())),
+            "vid": sorted(set(rec["vid"].tolist()))}
+    return TrackingData(table=table, ramps=tt.empty_ramps(), report=report, meta=meta)
+
+
+def _check(path, raw, errors, report) -> np.ndarray:
+    """Mask of sound records; the others are reported (sync bytes, time fields out of range)."""
+    sync = (raw["front"] == FRONT) & (raw["rear"] == REAR)
+    times = (raw["microseconds"] < 1_000_000) & (raw["seconds_of_year"] < 366 * 86400)
+    ok = sync & times
+    for i in np.flatnonzero(~ok):
+        why = "sync bytes 0D0A01 ... 040F0F missing" if not sync[i] else "time field out of range"
+        handle(ParseError(path, f"corrupt UTDF record: {why}", offset=int(i) * RECORD, record=int(i)),
+               errors, report)
+    return ok
+
+
+def records_frame(raw: np.ndarray, index: np.ndarray) -> pd.DataFrame:
+    """The records field by field (RECORD_FIELDS), indexed by record number in the file."""
+    df = pd.DataFrame({name: raw[name].astype(np.int64) for name in DTYPE.names
+                       if name not in ("range_hi", "range_lo", "doppler_hi", "doppler_lo")
+                       and DTYPE[name].kind == "u"}, index=pd.Index(index, name="record"))
+    df["range_delay"] = (raw["range_hi"].astype(np.int64) << 16) | raw["range_lo"]
+    df["doppler_count"] = (raw["doppler_hi"].astype(np.int64) << 16) | raw["doppler_lo"]
+    for name in ("front", "tdrss", "rear"):
+        df[name] = raw[name].astype(object)
+    df["router"] = np.char.decode(raw["router"], "latin-1").astype(object)
+    return df[RECORD_FIELDS]
+
+
+def encode(records: pd.DataFrame) -> bytes:
+    """75-byte records from a frame with RECORD_FIELDS (as read() puts in meta["records"]).
+
+    Raises ValueError when a field does not fit its bytes.
+    """
+    out = np.zeros(len(records), DTYPE)
+    for name in RECORD_FIELDS:
+        col = records[name].to_numpy()
+        if name in ("range_delay", "doppler_count"):
+            col = _fit(name, col, 48)
+            out[name.split("_")[0] + "_hi"] = col >> 16
+            out[name.split("_")[0] + "_lo"] = col & 0xFFFF
+        elif name == "router":
+            out[name] = np.char.encode(col.astype(str), "latin-1")
+        elif DTYPE[name].kind == "S":
+            out[name] = col
+        else:
+            out[name] = _fit(name, col, 8 * DTYPE[name].itemsize)
+    return out.tobytes()
+
+
+def _fit(name: str, col: np.ndarray, bits: int) -> np.ndarray:
+    """``col`` as int64, checked to hold unsigned ``bits``-bit values."""
+    col = np.asarray(col).astype(np.int64)
+    if len(col) and (col.min() < 0 or col.max() >= 1 << bits):
+        raise ValueError(f"UTDF field {name} out of range for {bits} bits")
+    return col
+
+
+def write(path, records: pd.DataFrame) -> None:
+    """Write records (RECORD_FIELDS) to ``path`` atomically (temporary file, then rename)."""
+    path = Path(path)
+    tmp = path.with_name(path.name + ".tmp")
+    tmp.write_bytes(encode(records))
+    os.replace(tmp, path)
+
+
+def epochs(rec: pd.DataFrame) -> np.ndarray:
+    """datetime64[ns] UTC time tags of records."""
+    yy = rec["year"].to_numpy().astype(np.int64)
+    year = np.where(yy >= 100, 1900 + yy, np.where(yy >= 70, 1900 + yy, 2000 + yy))
+    jan1 = (year - 1970).astype("datetime64[Y]").astype("datetime64[ns]")
+    ns = rec["seconds_of_year"].to_numpy().astype(np.int64) * 1_000_000_000 \
+        + rec["microseconds"].to_numpy().astype(np.int64) * 1000
+    return jan1 + ns.astype("timedelta64[ns]")
+
+
+def data_interval(tracker_and_interval: np.ndarray) -> np.ndarray:
+    """Data interval (s) from bits 0-10: seconds, or 1/samples-per-second when bit 10 is set."""
+    v = np.asarray(tracker_and_interval).astype(np.int64) & 0x7FF
+    rate = (~v & 0x7FF) + 1
+    return np.where(v & 0x400, 1.0 / rate, v.astype(float))
+
+
+def _table(rec: pd.DataFrame, source: str) -> pd.DataFrame:
+    """TrackingTable rows (range, Doppler, two angles) from the records frame."""
+    n = len(rec)
+    valid = rec["validity"].to_numpy().astype(np.int64)
+    band = (rec["band_and_type"].to_numpy() >> 4).astype(np.int64)
+    tx_hz = rec["transmit_freq_10hz"].to_numpy().astype(np.int64) * 10.0
+    tracker = rec["tracker_and_interval"].to_numpy().astype(np.int64)
+    interval = data_interval(tracker)
+    up = np.array([BANDS.get(b, ("", ""))[0] for b in range(16)], dtype=object)[band]
+    down = np.array([BANDS.get(b, ("", ""))[1] for b in range(16)], dtype=object)[band]
+    s_band = (band == 3) | (band == 8) | ((band == 0) & (tx_hz >= 2e9) & (tx_hz < 4e9))
+    factor_m = np.where((band == 6) | (band == 8) | (tx_hz >= 12e9), 100.0, 1000.0)
+    factor_k = np.where(s_band, 240 / 221, np.where(band == 1, 1.0, np.nan))
+    epoch = epochs(rec)
+    rng = rec["range_delay"].to_numpy()
+    cnt = rec["doppler_count"].to_numpy()
+    a1, a2 = rec["angle1"].to_numpy().astype(float), rec["angle2"].to_numpy().astype(float)
+    geometry = (rec["rx_antenna_type"].to_numpy() & 0x0F).astype(np.int64)
+    names = [np.array([GEOMETRY.get(g, ("angle_1", "angle_2"))[k] for g in range(16)], dtype=object)[geometry]
+             for k in (0, 1)]
+
+    doppler_hz, count_time = _doppler(rec, cnt, valid, interval, factor_m, epoch)
+    two_way = tx_hz > 0
+    parts = {
+        "range": ((valid & 1).astype(bool) | (rng != 0), rng / 256e9, "s", np.zeros(n), valid & 1),
+        "doppler": ((valid & 2).astype(bool) | (cnt != 0), doppler_hz, "Hz", count_time, (valid >> 1) & 1),
+        "angle1": ((valid & 4).astype(bool) | (a1 != 0), a1 / 2**32 * TWO_PI, "rad", np.zeros(n), (valid >> 2) & 1),
+        "angle2": ((valid & 4).astype(bool) | (a2 != 0), _signed_half_turn(a2 / 2**32 * TWO_PI), "rad",
+                   np.zeros(n), (valid >> 2) & 1),
+    }
+    observable = {"range": np.full(n, "range", dtype=object),
+                  "doppler": np.where(two_way, "doppler_2way", "doppler_1way").astype(object),
+                  "angle1": names[0], "angle2": names[1]}
+    tag = {"range": "receive", "doppler": "interval_end", "angle1": "receive", "angle2": "receive"}
+    frames = []
+    for kind, (present, value, unit, ctime, bit) in parts.items():
+        rows = np.flatnonzero(present)
+        frames.append(pd.DataFrame({"_order": rows * 4 + list(parts).index(kind), "_rows": rows,
+                                    "_kind": kind, "value": value[rows], "unit": unit,
+                                    "count_time": ctime[rows], "observable": observable[kind][rows],
+                                    "tag": tag[kind], "valid": bit[rows].astype(bool)}))
+    rows = pd.concat(frames, ignore_index=True).sort_values("_order", kind="stable")
+    r = rows["_rows"].to_numpy()
+    tx_pad = rec["tx_pad"].to_numpy()
+    sic = rec["sic"].to_numpy()
+    is_doppler = (rows["_kind"] == "doppler").to_numpy()
+    return tt.build(
+        len(rows), epoch=epoch[r], tag=rows["tag"].to_numpy(), observable=rows["observable"].to_numpy(),
+        value=rows["value"].to_numpy(), unit=rows["unit"].to_numpy(),
+        count_time=rows["count_time"].to_numpy(),
+        station_tx=np.where(two_way[r], _pads(tx_pad[r]), "").astype(object),
+        station_rx=_pads(rec["rx_pad"].to_numpy()[r]),
+        spacecraft=sic[r].astype(str).astype(object),
+        band_up=np.where(two_way[r], up[r], "").astype(object), band_down=down[r],
+        uplink_hz=np.where(two_way[r], tx_hz[r], np.nan),
+        transponder_ratio=np.where(two_way[r], factor_k[r], np.nan),
+        source=source, record=rec.index.to_numpy()[r].astype(np.int64), flags=0,
+        valid=rows["valid"].to_numpy(), vid=rec["vid"].to_numpy()[r].astype(np.int64),
+        validity=valid[r], tracker_type=(tracker[r] >> 12), last_frame=((tracker[r] >> 11) & 1).astype(bool),
+        data_interval_s=interval[r], band_code=band[r],
+        transmission_type=(rec["band_and_type"].to_numpy()[r] & 0x0F).astype(np.int64),
+        mode=rec["mode"].to_numpy()[r].astype(np.int64), agc=rec["agc"].to_numpy()[r].astype(np.int64),
+        tx_antenna_type=rec["tx_antenna_type"].to_numpy()[r].astype(np.int64),
+        rx_antenna_type=rec["rx_antenna_type"].to_numpy()[r].astype(np.int64),
+        doppler_count=np.where(is_doppler, cnt[r], -1),
+        doppler_bias_hz=np.where(is_doppler, DOPPLER_BIAS_HZ, np.nan),
+        factor_m=np.where(is_doppler, factor_m[r], np.nan),
+        router=rec["router"].to_numpy()[r], tdrss=rec["tdrss"].to_numpy()[r],
+    )
+
+
+def _doppler(rec, cnt, valid, interval, factor_m, epoch):
+    """Doppler shift (Hz) and count time (s) per record from the running or destruct count."""
+    has = ((valid & 2) != 0) | (cnt != 0)
+    destruct = (valid & 64) != 0
+    series = pd.factorize(pd.MultiIndex.from_arrays([rec["sic"].to_numpy(), rec["vid"].to_numpy(),
+                                                     rec["rx_pad"].to_numpy(), has & ~destruct]))[0]
+    prev = pd.Series(np.arange(len(rec))).groupby(series).shift(1).to_numpy()
+    has_prev = ~np.isnan(prev) & has & ~destruct
+    p = np.where(has_prev, prev, 0).astype(np.int64)
+    dt = (epoch - epoch[p]).astype(np.int64) / 1e9
+    dn = (cnt - cnt[p]) % COUNT_WRAP
+    with np.errstate(invalid="ignore", divide="ignore"):
+        running = (dn / dt - DOPPLER_BIAS_HZ) / factor_m
+        single = (cnt / interval - DOPPLER_BIAS_HZ) / factor_m
+    hz = np.where(destruct, single, np.where(has_prev & (dt > 0), running, np.nan))
+    count_time = np.where(destruct, interval, np.where(has_prev & (dt > 0), dt, np.nan))
+    return hz, count_time
+
+
+def _signed_half_turn(angle: np.ndarray) -> np.ndarray:
+    """Map [0, 2 pi) to [-pi, pi) (elevation and Y angles may be negative)."""
+    return np.where(angle >= np.pi, angle - TWO_PI, angle)
+
+
+def _pads(pads: np.ndarray) -> np.ndarray:
+    """Station names from antenna pad ids: 'PAD-119'."""
+    names = np.array([f"PAD-{i}" for i in range(256)], dtype=object)
+    return names[pads.astype(np.int64)]
