@@ -21,7 +21,7 @@ def _command_modules():
 
 
 def build_parser() -> argparse.ArgumentParser:
-    parser = argparse.ArgumentParser(prog="odpipe", description=__doc__.splitlines()[0])
+    parser = argparse.ArgumentParser(prog="odpipe", description="Orbit-determination post-processing of radiometric tracking data.")
     parser.add_argument("--version", action="version", version=f"odpipe {odpipe.__version__}")
     sub = parser.add_subparsers(dest="command", metavar="COMMAND")
     for mod in _command_modules():

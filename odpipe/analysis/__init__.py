@@ -1,0 +1,1 @@
+"""Analysis of solutions: overlap precision, observability, covariance."""

@@ -1,0 +1,1 @@
+"""Navigation products made from a solution: trajectories (OEM, SPK), tables, plots, reports."""

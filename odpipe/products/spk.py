@@ -1,0 +1,42 @@
+"""SPICE SPK (type 13, Hermite on unequal steps) trajectory writer through spiceypy.
+
+SPK epochs are TDB seconds past J2000 (SPICE's ET), the models' own time, so
+no time conversion is made; states go in km and km/s, frame 'J2000', which
+SPICE's planetary ephemerides use as a label for the ICRF axes.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+import spiceypy as sp
+
+from odpipe.products.atomic import atomic_path
+from odpipe.products.ephemeris import EphemerisSegment
+
+# NAIF ids of the centres a segment may name.
+NAIF_IDS = {"ssb": 0, "sun": 10, "mercury": 199, "venus": 299, "earth": 399, "moon": 301, "emb": 3, "mars": 4,
+            "jupiter": 5, "saturn": 6, "uranus": 7, "neptune": 8, "pluto": 9}
+
+
+def write_spk(path, segments: list[EphemerisSegment], body_id: int, *, degree: int = 7,
+              segment_id: str = "odpipe") -> None:
+    """Write segments of body ``body_id`` (a NAIF id, e.g. -181) to a new SPK, atomically.
+
+    ``degree`` is the Hermite polynomial degree (odd, 1..27); SPICE uses
+    (degree+1)/2 states per interpolation window.
+    """
+    if degree % 2 == 0:
+        raise ValueError("SPK type 13 needs an odd Hermite degree")
+    centers = [NAIF_IDS.get(seg.center.lower()) for seg in segments]
+    unknown = [seg.center for seg, c in zip(segments, centers) if c is None]
+    if unknown:
+        raise ValueError(f"no NAIF id known for centre(s) {unknown}")
+    with atomic_path(path) as tmp:
+        handle = sp.spkopn(str(tmp), "odpipe", 0)
+        try:
+            for seg, center in zip(segments, centers):
+                sp.spkw13(handle, body_id, center, "J2000", float(seg.t_tdb[0]), float(seg.t_tdb[-1]),
+                          segment_id[:40], degree, len(seg.t_tdb), np.ascontiguousarray(seg.states / 1e3),
+                          np.ascontiguousarray(seg.t_tdb))
+        finally:
+            sp.spkcls(handle)

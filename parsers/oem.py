@@ -1,0 +1,114 @@
+"""CCSDS Orbit Ephemeris Message (OEM, KVN) reader.
+
+Returns one :class:`OemSegment` per META block: its metadata, epochs as
+datetime64[ns] in the file's own TIME_SYSTEM (named in ``meta``), states in
+m and m/s (the file's km, km/s converted), and covariances in m², m²/s,
+m²/s² when the segment has a covariance block.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from pathlib import Path
+
+import numpy as np
+
+from parsers.errors import ParseError
+
+_TRIL = np.tril_indices(6)
+_SCALE = 1e3  # km -> m
+
+
+@dataclass
+class OemSegment:
+    meta: dict
+    epochs: np.ndarray
+    states: np.ndarray
+    cov_epochs: np.ndarray = field(default_factory=lambda: np.array([], dtype="datetime64[ns]"))
+    covariances: np.ndarray = field(default_factory=lambda: np.zeros((0, 6, 6)))
+
+
+def sniff(head: bytes) -> bool:
+    return head.lstrip().startswith(b"CCSDS_OEM_VERS")
+
+
+def read(path) -> list[OemSegment]:
+    """Read every segment of a KVN OEM; ParseError names the file and line."""
+    path = Path(path)
+    lines = path.read_text().splitlines()
+    if not lines or not sniff(lines[0].encode()):
+        raise ParseError(path, "not a KVN OEM (no CCSDS_OEM_VERS header)", line=1)
+    segments, meta, rows, cov_rows, cov_epochs = [], None, [], [], []
+    state = "header"
+
+    def close(lineno):
+        if meta is None:
+            return
+        if not rows:
+            raise ParseError(path, "segment without ephemeris data lines", line=lineno)
+        epochs = np.array([_epoch(path, n, r[0]) for n, r in rows], dtype="datetime64[ns]")
+        states = np.array([[_number(path, n, v) for v in r[1:7]] for n, r in rows]) * _SCALE
+        covs = np.zeros((len(cov_rows), 6, 6))
+        for k, (n, vals) in enumerate(cov_rows):
+            covs[k][_TRIL] = vals
+            covs[k] = covs[k] + np.tril(covs[k], -1).T
+        segments.append(OemSegment(meta, epochs, states, np.array(cov_epochs, dtype="datetime64[ns]"),
+                                   covs * _SCALE**2))
+
+    cov_vals: list[float] = []
+    for lineno, raw in enumerate(lines, start=1):
+        text = raw.strip()
+        if not text or text.startswith("COMMENT"):
+            continue
+        if text == "META_START":
+            close(lineno)
+            meta, rows, cov_rows, cov_epochs, state = {}, [], [], [], "meta"
+        elif text == "META_STOP":
+            state = "data"
+        elif text == "COVARIANCE_START":
+            state = "cov"
+        elif text == "COVARIANCE_STOP":
+            if cov_vals:
+                raise ParseError(path, "incomplete covariance matrix", line=lineno)
+            state = "data"
+        elif state in ("header", "meta") or (state == "cov" and "=" in text):
+            key, sep, value = text.partition("=")
+            if not sep:
+                raise ParseError(path, f"expected KEY = value, got {text!r}", line=lineno)
+            key, value = key.strip(), value.strip()
+            if state == "meta":
+                meta[key] = value
+            elif state == "cov" and key == "EPOCH":
+                if cov_vals:
+                    raise ParseError(path, "covariance EPOCH before the previous matrix was complete", line=lineno)
+                cov_epochs.append(_epoch(path, lineno, value))
+        elif state == "data":
+            fields = text.split()
+            if len(fields) not in (7, 10):
+                raise ParseError(path, f"ephemeris line needs 7 or 10 fields, got {len(fields)}", line=lineno)
+            rows.append((lineno, fields))
+        elif state == "cov":
+            cov_vals += [_number(path, lineno, v) for v in text.split()]
+            if len(cov_vals) > 21:
+                raise ParseError(path, "covariance has more than 21 lower-triangle numbers", line=lineno)
+            if len(cov_vals) == 21:
+                cov_rows.append((lineno, np.array(cov_vals)))
+                cov_vals = []
+    close(len(lines))
+    if not segments:
+        raise ParseError(path, "no META_START block", line=len(lines))
+    return segments
+
+
+def _epoch(path, lineno, text):
+    try:
+        return np.datetime64(text.rstrip("Z"), "ns")
+    except ValueError:
+        raise ParseError(path, f"bad epoch {text!r}", line=lineno) from None
+
+
+def _number(path, lineno, text):
+    try:
+        return float(text)
+    except ValueError:
+        raise ParseError(path, f"bad number {text!r}", line=lineno) from None
