@@ -22,7 +22,7 @@ from pathlib import Path
 
 import numpy as np
 
-from odpipe.time.scales import J2000_JD
+from odpipe.environment.ephemeris import jd_split
 
 ARCSEC = np.pi / (180.0 * 3600.0)
 _DEG = np.pi / 180.0
@@ -47,26 +47,26 @@ def _rot(axis: int, angle) -> np.ndarray:
 
 @lru_cache(maxsize=4)
 def _libration_source(path: str | None):
-    """Callable jd2 -> (3, N) Euler angles (rad) from the de421 package or a binary PCK."""
+    """Callable (jd1, jd2) -> (3, N) Euler angles (rad) from the de421 package or a binary PCK."""
     if path is None:
         import de421
         from jplephem.ephem import Ephemeris as PackageEphemeris
         eph = PackageEphemeris(de421)
-        return lambda jd2: eph.position("librations", J2000_JD, jd2)
+        return lambda jd1, jd2: eph.position("librations", jd1, jd2)
     from jplephem.pck import PCK
     p = Path(path)
     if not p.is_file():
         raise ValueError(f"lunar orientation kernel {p} does not exist")
     seg = PCK.open(str(p)).segments[0]
-    return lambda jd2: seg.compute(J2000_JD, jd2, derivative=False)
+    return lambda jd1, jd2: seg.compute(jd1, jd2, derivative=False)
 
 
 def moon_pa_to_icrf(t_tdb, kernel: str | Path | None = None) -> np.ndarray:
     """Rotation matrices Moon PA → ICRF at TDB s past J2000 (DE421 librations)."""
     t = np.asarray(t_tdb, dtype=float)
-    jd2 = np.atleast_1d(t / 86400.0)
+    jd1, jd2 = jd_split(t)
     try:
-        phi, theta, psi = np.reshape(_libration_source(None if kernel is None else str(kernel))(jd2), (3, -1))
+        phi, theta, psi = np.reshape(_libration_source(None if kernel is None else str(kernel))(jd1, jd2), (3, -1))
     except Exception as err:  # jplephem raises its own DateError/ValueError types
         raise ValueError(f"lunar librations unavailable for TDB {t.min():.1f}..{t.max():.1f} s past J2000: {err}") from err
     icrf_to_pa = _rot(3, psi) @ _rot(1, theta) @ _rot(3, phi)
