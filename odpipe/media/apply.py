@@ -86,28 +86,32 @@ def calibrate(table: pd.DataFrame, model: MediaModel, *, target_itrs=None,
     out["iono_m"] = _row_sum(n, rows, sign * iono, ground)
     out["media_m"] = out["tropo_m"] + out["iono_m"]
     is_range = obs == "range"
-    f_ru = out["uplink_hz"].to_numpy(dtype=float) * range_unit_factor(out["band_up"].to_numpy())
+    bands, band_idx = np.unique(out["band_up"].to_numpy(dtype=str), return_inverse=True)
+    f_ru = out["uplink_hz"].to_numpy(dtype=float) * range_unit_factor(bands)[band_idx]
     out["media_ru"] = np.where(is_range, out["media_m"].to_numpy() / C_LIGHT * f_ru, np.nan)
-    text = "tropo: " + lab_t + " | iono: " + lab_i
-    first = (sign > 0)
+    code, texts = pd.factorize("tropo: " + pd.Series(lab_t) + " | iono: " + pd.Series(lab_i))
+    texts = np.append(np.asarray(texts, dtype=object), "")
+    first = sign > 0
     for leg, col in (("down", "media_source"), ("up", "media_source_up")):
         pick = first & (s["leg"].to_numpy() == leg)
-        labels = np.full(n, "", dtype=object)
-        labels[rows[pick]] = text[pick]
-        out[col] = labels
-    out["media_note"] = _notes(n, rows, text.astype(str), ground, np.isin(obs, TWO_LEG), rtlt_note)
+        row_code = np.full(n, len(texts) - 1)
+        row_code[rows[pick]] = code[pick]
+        out[col] = pd.Categorical(texts[row_code])
+    out["media_note"] = _notes(n, rows, code, texts.astype(str), ground, np.isin(obs, TWO_LEG), rtlt_note)
     return out, pass_report(out)
 
 
 def _frequencies(t: pd.DataFrame):
     """(uplink Hz, downlink Hz) per row: table values, turnaround, else nominal band frequency."""
     up = t["uplink_hz"].to_numpy(dtype=float)
-    nominal_up = np.array([NOMINAL_HZ.get(("up", str(b).upper()), np.nan) for b in t["band_up"]])
-    nominal_dn = np.array([NOMINAL_HZ.get(("down", str(b).upper()), np.nan) for b in t["band_down"]])
-    f_up = np.where(np.isfinite(up), up, nominal_up)
+    nominal = {}
+    for leg, col in (("up", "band_up"), ("down", "band_down")):
+        bands, idx = np.unique(t[col].to_numpy(dtype=str), return_inverse=True)
+        nominal[leg] = np.array([NOMINAL_HZ.get((leg, b.upper()), np.nan) for b in bands])[idx]
+    f_up = np.where(np.isfinite(up), up, nominal["up"])
     one_way = t["observable"].to_numpy(dtype=object) == "doppler_1way"
     turned = f_up * t["transponder_ratio"].to_numpy(dtype=float)
-    f_down = np.where(one_way & np.isfinite(up), up, np.where(np.isfinite(turned), turned, nominal_dn))
+    f_down = np.where(one_way & np.isfinite(up), up, np.where(np.isfinite(turned), turned, nominal["down"]))
     return f_up, f_down
 
 
@@ -182,23 +186,24 @@ def _row_sum(n, rows, values, ground):
     return np.where(ground & ~bad, out, np.nan)
 
 
-def _notes(n, rows, sample_labels, ground, two_leg, rtlt_note):
-    """Per row: why its correction is partial or a fallback (from every sample's source labels)."""
-    reasons = [(np.char.find(sample_labels, flag) >= 0, text) for flag, text in (
-        ("(no TRO)", "no TRO coverage: DSN seasonal model used"),
-        ("standard-atmosphere", "non-DSN station: standard atmosphere used"),
-        ("iono: none", "no ionosphere calibration: none applied"),
-        ("no direction", "no spacecraft direction or below horizon: no correction"),
-        ("no station", "station not in catalog: no correction"))]
-    notes = []
-    for hit, text in reasons:
-        row_hit = np.zeros(n, dtype=bool)
-        np.logical_or.at(row_hit, rows, hit)
-        notes.append(np.where(row_hit, text, ""))
-    if rtlt_note:
-        notes.append(np.where(two_leg, rtlt_note, ""))
-    notes.append(np.where(ground, "", "not a ground radiometric observable: no correction"))
-    return np.array(["; ".join(p for p in parts if p) for parts in zip(*notes)], dtype=object)
+def _notes(n, rows, code, texts, ground, two_leg, rtlt_note):
+    """Per row: why its correction is partial or a fallback (from every sample's source text)."""
+    reasons = [("(no TRO)", "no TRO coverage: DSN seasonal model used"),
+               ("standard-atmosphere", "non-DSN station: standard atmosphere used"),
+               ("iono: none", "no ionosphere calibration: none applied"),
+               ("no direction", "no spacecraft direction or below horizon: no correction"),
+               ("no station", "station not in catalog: no correction")]
+    bits = np.zeros(n, dtype=np.int64)
+    for k, (flag, _) in enumerate(reasons):
+        hit = (np.char.find(texts, flag) >= 0)[code]
+        np.bitwise_or.at(bits, rows[hit], 1 << k)
+    extra = [(two_leg, rtlt_note), (~ground, "not a ground radiometric observable: no correction")]
+    for k, (mask, _) in enumerate(extra, len(reasons)):
+        bits |= np.where(mask, 1 << k, 0)
+    words = [text for _, text in reasons] + [text for _, text in extra]
+    uniq, inv = np.unique(bits, return_inverse=True)
+    names = ["; ".join(w for k, w in enumerate(words) if u >> k & 1 and w) for u in uniq]
+    return pd.Categorical(np.asarray(names, dtype=object)[inv])
 
 
 def pass_report(t: pd.DataFrame) -> pd.DataFrame:
