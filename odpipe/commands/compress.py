@@ -1,0 +1,26 @@
+"""``odpipe compress``: Doppler compression of a TrackingTable file."""
+
+from __future__ import annotations
+
+from odpipe.preprocess import store
+from odpipe.preprocess.compress import compress
+
+NAME = "compress"
+HELP = "compress Doppler to a longer count time (exact averages / phase differences)"
+
+
+def add_arguments(parser) -> None:
+    parser.add_argument("input", help="TrackingTable Parquet (ramps read from IN.ramps.parquet if present)")
+    parser.add_argument("-o", "--output", required=True, help="output Parquet")
+    parser.add_argument("--count-time", type=float, default=60.0, help="target count time, s (default 60)")
+    parser.add_argument("--partial", choices=("keep", "flag", "drop"), default="keep",
+                        help="short windows: keep as shorter counts, flag them, or drop and report")
+    parser.add_argument("--max-gap", type=float, default=600.0, help="pass break at gaps longer than this, s")
+
+
+def run(args) -> int:
+    table, ramps = store.read(args.input)
+    out, report = compress(table, args.count_time, ramps=ramps, partial=args.partial, max_gap=args.max_gap)
+    store.write(args.output, out, ramps)
+    print("\n".join(report.lines()))
+    return 0

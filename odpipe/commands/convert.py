@@ -1,0 +1,50 @@
+"""``odpipe convert``: any readable tracking file to Parquet or CCSDS TDM."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+from odpipe.preprocess import store
+from parsers import formats
+from parsers.table import TrackingData
+
+NAME = "convert"
+HELP = "convert a tracking file to TrackingTable Parquet (.parquet) or CCSDS TDM (.tdm/.kvn KVN, .xml XML)"
+TDM_SYNTAX = {".tdm": "kvn", ".kvn": "kvn", ".xml": "xml"}
+
+
+def add_arguments(parser) -> None:
+    parser.add_argument("input", help="tracking file in any readable format, or TrackingTable Parquet")
+    parser.add_argument("-o", "--output", required=True, help="OUT.parquet, OUT.tdm, OUT.kvn or OUT.xml")
+    parser.add_argument("--errors", choices=("raise", "report"), default="raise",
+                        help="on a corrupt record: stop, or skip it and report")
+
+
+def load(path, errors: str = "raise") -> TrackingData:
+    """TrackingData from a TrackingTable Parquet file or any file a reader recognises."""
+    if str(path).endswith(".parquet"):
+        return TrackingData(*store.read(path))
+    data = formats.read_any(path, errors=errors)
+    if not isinstance(data, TrackingData):
+        raise ValueError(f"{path} is not tracking data")
+    return data
+
+
+def run(args) -> int:
+    data = load(args.input, args.errors)
+    suffix = Path(args.output).suffix.lower()
+    if suffix == ".parquet":
+        written = store.write(args.output, data.table, data.ramps)
+    elif suffix in TDM_SYNTAX:
+        from parsers import tdm
+
+        if "segments" not in data.meta:
+            print("TDM output needs TDM segment metadata: only a file read as TDM can be written as TDM yet")
+            return 2
+        tdm.write(args.output, data, syntax=TDM_SYNTAX[suffix])
+        written = [args.output]
+    else:
+        print(f"cannot write {suffix!r}: use .parquet, .tdm, .kvn or .xml")
+        return 2
+    print(f"{len(data.table)} rows -> {', '.join(map(str, written))}; {len(data.report)} records reported unreadable")
+    return 0

@@ -1,0 +1,88 @@
+"""``odpipe inspect``: what is in a tracking file - format, span, counts, ramps, anomalies."""
+
+from __future__ import annotations
+
+import importlib
+
+import pandas as pd
+
+from parsers import formats
+from parsers.errors import ParseReport
+from parsers.table import TrackingData
+from odpipe.preprocess import ramp_segments, store
+
+NAME = "inspect"
+HELP = "detect a file's format and summarize its contents and anomalies"
+SHOWN_ERRORS = 5
+
+
+def add_arguments(parser) -> None:
+    parser.add_argument("files", nargs="+", help="tracking files (any readable format) or TrackingTable Parquet")
+
+
+def _counts(table: pd.DataFrame, col: str) -> str:
+    c = table[col].replace("", "-").value_counts().sort_index()
+    return ", ".join(f"{k} {v}" for k, v in c.items())
+
+
+def tracking_summary(data: TrackingData) -> list[str]:
+    """Lines describing a TrackingData."""
+    t = data.table
+    out = [f"rows: {len(t)}"]
+    if len(t):
+        out.append(f"span: {t['epoch'].min()} .. {t['epoch'].max()} UTC")
+        for col in ("observable", "station_tx", "station_rx", "spacecraft", "band_up", "band_down", "tag"):
+            out.append(f"{col}: {_counts(t, col)}")
+        ct = t.loc[t["count_time"] > 0, "count_time"].value_counts().sort_index()
+        out.append("count times (s): " + (", ".join(f"{k:g} x{v}" for k, v in ct.items()) or "none"))
+        out.append(f"ramped rows: {int(t['ramped'].sum())}")
+        if "validity" in t:
+            out.append(f"rows the format marks invalid: {int((t['validity'] != 0).sum())}")
+        dup = t.duplicated(subset=["epoch", "observable", "station_tx", "station_rx", "band_up", "band_down",
+                                   "spacecraft"]).sum()
+        out.append(f"duplicate samples: {int(dup)}")
+    rs = ramp_segments.store(data.ramps)
+    if rs is not None:
+        per = rs.segments.groupby("station").size()
+        out.append("ramps: " + ", ".join(f"{k} {v}" for k, v in per.items()))
+        kinds = rs.findings["kind"].value_counts()
+        out.append("ramp findings: " + (", ".join(f"{k} {v}" for k, v in kinds.items()) or "none"))
+    return out
+
+
+def report_lines(report: ParseReport) -> list[str]:
+    """The reader's skipped records, the first few spelled out."""
+    lines = [f"unreadable records: {len(report)}"]
+    lines += [f"  {e}" for e in list(report)[:SHOWN_ERRORS]]
+    if len(report) > SHOWN_ERRORS:
+        lines.append(f"  ... {len(report) - SHOWN_ERRORS} more")
+    return lines
+
+
+def summarize(path) -> list[str]:
+    """Lines describing one file."""
+    if str(path).endswith(".parquet"):
+        table, ramps = store.read(path)
+        return ["format: TrackingTable Parquet"] + tracking_summary(TrackingData(table, ramps))
+    name = formats.detect(path)
+    if name is None:
+        return [f"format: not recognised (readers available: {', '.join(formats.available())})"]
+    report = ParseReport()
+    mod = importlib.import_module(name)
+    if name == "parsers.maneuvers":
+        df = mod.read(path, errors="report", report=report)
+        lines = [f"format: {name}", f"rows: {len(df)}"]
+        if len(df):
+            lines.append(f"span: {df['epoch'].min()} .. {df['epoch'].max()} UTC")
+        if "kind" in df:
+            lines.append("kinds: " + ", ".join(f"{k} {v}" for k, v in df["kind"].value_counts().items()))
+        return lines + report_lines(report)
+    data = mod.read(path, errors="report")
+    return [f"format: {name}"] + tracking_summary(data) + report_lines(data.report)
+
+
+def run(args) -> int:
+    for path in args.files:
+        print(f"== {path}")
+        print("\n".join(summarize(path)))
+    return 0

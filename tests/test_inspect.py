@@ -1,0 +1,114 @@
+"""Format detection, ``odpipe inspect`` on real ODFs, and the convert -> edit -> compress command chain."""
+
+from collections import Counter
+
+import numpy as np
+import pandas as pd
+import pytest
+
+from odpipe.cli import main
+from parsers import formats
+
+TYPES = {"11": "doppler_1way", "12": "doppler_2way", "13": "doppler_3way", "36": "range", "37": "range"}
+
+
+def inspect_lines(capsys, *paths):
+    assert main(["inspect", *map(str, paths)]) == 0
+    return capsys.readouterr().out.splitlines()
+
+
+def field(lines, name):
+    """Parsed 'name: k v, k v' line of the inspect output."""
+    text = next(ln for ln in lines if ln.startswith(name + ":")).split(":", 1)[1]
+    return dict((kv.rsplit(" ", 1)[0].strip(), kv.rsplit(" ", 1)[1]) for kv in text.split(","))
+
+
+@pytest.mark.realdata
+def test_detect_formats_of_real_files(shared_data, tmp_path):
+    expect = {"grail/grblugf2012_099_0620smmmv1.odf": "parsers.odf",
+              "cassini/S18TIGM2006_058_0005X25MV1.ODF": "parsers.odf",
+              "utdf/LSUTDF_367501_119_2019_044_1555.trk": "parsers.utdf",
+              "grail/mas00_2012_04_06_a_04.asc": "parsers.maneuvers"}
+    for rel, name in expect.items():
+        if name in formats.available():
+            assert formats.detect(shared_data / rel) == name, rel
+    (tmp_path / "notes.txt").write_text("nothing to see here\n")
+    assert formats.detect(tmp_path / "notes.txt") is None
+    assert main(["inspect", str(tmp_path / "notes.txt")]) == 0
+
+
+@pytest.mark.realdata
+def test_inspect_messenger_matches_the_independent_listing(shared_data, capsys):
+    pytest.importorskip("parsers.odf")
+    rows = [ln.split() for ln in (shared_data / "messenger" / "odf07155.txt").read_text().splitlines()]
+    data = [r for r in rows if len(r) == 19 and r[0].replace(".", "").isdigit()]
+    want = Counter(TYPES[r[7]] for r in data)
+    lines = inspect_lines(capsys, shared_data / "messenger" / "odf07155.odf")
+    assert "format: parsers.odf" in lines and f"rows: {len(data)}" in lines
+    assert {k: int(v) for k, v in field(lines, "observable").items()} == dict(want)
+    t = np.array([float(r[0]) for r in data])
+    first = np.datetime64("1950-01-01") + np.timedelta64(int(t.min()), "s")
+    last = np.datetime64("1950-01-01") + np.timedelta64(int(t.max()), "s")
+    assert f"span: {pd.Timestamp(first)} .. {pd.Timestamp(last)} UTC" in lines
+    doppler_ct = Counter(int(r[17]) / 100 for r in data if r[7] in ("11", "12", "13"))
+    assert f"count times (s): " + ", ".join(f"{k:g} x{v}" for k, v in sorted(doppler_ct.items())) in lines
+    assert "unreadable records: 0" in lines
+
+
+@pytest.mark.realdata
+def test_inspect_grail_and_cassini_agree_with_the_data_notes(shared_data, capsys):
+    pytest.importorskip("parsers.odf")
+    grail = sorted((shared_data / "grail").glob("*.odf"))
+    lines = inspect_lines(capsys, *grail)
+    blocks = "\n".join(lines).split("== ")[1:]
+    stations = set()
+    for block in blocks:
+        b = block.splitlines()
+        assert "format: parsers.odf" in b
+        assert field(b, "spacecraft") .keys() == {"181"}                 # README: DSN id 181
+        assert set(field(b, "observable")) == {"doppler_1way", "doppler_2way"}
+        assert "count times (s): 1" in next(ln for ln in b if ln.startswith("count times"))
+        assert next(ln for ln in b if ln.startswith("ramps:"))            # ramp groups present
+        stations |= set(field(b, "station_rx"))
+    # README: DSS-14/15/24/25/27/34/54/55/65 over the four files
+    assert stations <= {f"DSS-{n}" for n in (14, 15, 24, 25, 27, 34, 54, 55, 65)} and len(stations) >= 8
+    cas = inspect_lines(capsys, shared_data / "cassini" / "S18TIGM2006_058_0005X25MV1.ODF")
+    assert field(cas, "spacecraft").keys() == {"82"}
+    assert set(field(cas, "observable")) == {"doppler_2way", "doppler_3way", "range"}
+    assert set(field(cas, "band_down")) == {"X", "Ka"} and set(field(cas, "station_rx")) == {"DSS-25", "DSS-34"}
+    assert next(ln for ln in cas if ln.startswith("span:")).startswith("span: 2006-02-27")
+
+
+@pytest.mark.realdata
+def test_convert_edit_compress_commands(shared_data, tmp_path, capsys):
+    pytest.importorskip("parsers.odf")
+    from odpipe.preprocess import store
+    from odpipe.preprocess.flags import Flag
+
+    src = shared_data / "grail" / "grblugf2012_099_0620smmmv1.odf"
+    raw, edited, comp = tmp_path / "raw.parquet", tmp_path / "edited.parquet", tmp_path / "c60.parquet"
+    assert main(["convert", str(src), "-o", str(raw)]) == 0
+    assert main(["edit", str(raw), "-o", str(edited)]) == 0
+    assert main(["compress", str(edited), "-o", str(comp), "--count-time", "60"]) == 0
+    out = capsys.readouterr().out
+    t_raw, ramps = store.read(raw)
+    t_edit, _ = store.read(edited)
+    t_comp, ramps_c = store.read(comp)
+    assert len(t_raw) == len(t_edit) == 41810 and ramps is not None and len(ramps_c) == len(ramps)
+    # the 2.8e7 Hz one-way record 21121 is edited as a blunder and survives compression flagged
+    row = t_comp[t_comp["record"] == 21121]
+    assert len(row) == 1 and row["flags"].iloc[0] & int(Flag.BLUNDER)
+    assert sum(len(r) for r in t_comp["source_records"]) == len(t_raw)
+    assert t_comp["count_time"].max() == 60.0 and "raw records not represented: 0" in out
+    assert main(["convert", str(src), "-o", str(tmp_path / "x.tdm")]) == 2  # no TDM metadata in an ODF
+
+
+@pytest.mark.realdata
+def test_convert_tdm_between_syntaxes(shared_data, tmp_path):
+    if "parsers.tdm" not in formats.available():
+        pytest.skip("parsers.tdm not present")
+    src = shared_data / "tdm" / "kvn" / "TDMExample2.txt"
+    assert main(["convert", str(src), "-o", str(tmp_path / "e2.xml")]) == 0
+    a, b = formats.read_any(src).table, formats.read_any(tmp_path / "e2.xml").table
+    assert formats.detect(tmp_path / "e2.xml") == "parsers.tdm"
+    assert np.array_equal(a["value"], b["value"]) and np.array_equal(a["epoch"], b["epoch"])
