@@ -1,0 +1,1 @@
+"""Runs: configuration files, run directories with manifests, reports, nightly batches."""

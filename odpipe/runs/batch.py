@@ -1,0 +1,69 @@
+"""Nightly batches: many arcs in parallel on Dask, resumable, one failure never stopping the rest.
+
+Each arc is a run configuration; ``run_one(config_path) -> dict`` runs it and
+returns at least ``{"status": "complete" | "skipped", ...}``. An arc whose
+products are complete and whose config and inputs are unchanged is skipped
+by ``run_one`` itself (see :func:`odpipe.runs.rundir.up_to_date`), so a
+batch killed at any point is simply started again.
+"""
+
+from __future__ import annotations
+
+import time
+import traceback
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Callable
+
+
+@dataclass
+class ArcOutcome:
+    config: str
+    status: str  # complete | skipped | failed
+    seconds: float
+    detail: dict = field(default_factory=dict)
+    error: str = ""
+
+
+def _guarded(run_one: Callable[[Path], dict], config: str) -> ArcOutcome:
+    t0 = time.perf_counter()
+    try:
+        detail = run_one(Path(config)) or {}
+        return ArcOutcome(config, detail.get("status", "complete"), time.perf_counter() - t0, detail)
+    except Exception as exc:  # one arc's failure is reported, never fatal to the batch
+        return ArcOutcome(config, "failed", time.perf_counter() - t0,
+                          error="".join(traceback.format_exception_only(exc)).strip())
+
+
+def run_batch(configs, run_one: Callable[[Path], dict], *, scheduler: str | None = None, workers: int = 2,
+              progress: Callable[[str], None] = print) -> list[ArcOutcome]:
+    """Run every arc config; returns one outcome per arc in completion order.
+
+    ``scheduler`` is the address of a running Dask scheduler; without it a
+    local cluster of ``workers`` single-threaded processes is started.
+    """
+    from distributed import Client, LocalCluster, as_completed
+
+    configs = [str(c) for c in configs]
+    cluster = None if scheduler else LocalCluster(n_workers=workers, threads_per_worker=1,
+                                                  processes=True, dashboard_address=None)
+    outcomes: list[ArcOutcome] = []
+    with Client(scheduler or cluster) as client:
+        futures = [client.submit(_guarded, run_one, c, key=f"arc-{i}", pure=False) for i, c in enumerate(configs)]
+        for k, fut in enumerate(as_completed(futures), start=1):
+            out = fut.result()
+            outcomes.append(out)
+            note = f": {out.error}" if out.error else ""
+            progress(f"[{k}/{len(configs)}] {Path(out.config).name}: {out.status} in {out.seconds:.1f} s{note}")
+    if cluster is not None:
+        cluster.close()
+    return outcomes
+
+
+def night_summary(outcomes: list[ArcOutcome]) -> str:
+    """A few lines that say how the night went."""
+    counts = {s: sum(o.status == s for o in outcomes) for s in ("complete", "skipped", "failed")}
+    lines = [f"{len(outcomes)} arcs: {counts['complete']} run, {counts['skipped']} unchanged (skipped), "
+             f"{counts['failed']} failed"]
+    lines += [f"  FAILED {o.config}: {o.error}" for o in outcomes if o.status == "failed"]
+    return "\n".join(lines)
