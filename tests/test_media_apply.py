@@ -1,7 +1,6 @@
 """Applying media corrections to a TrackingTable: legs, times, signs, sources and smoothing."""
 
 import numpy as np
-import pandas as pd
 import pytest
 
 from odpipe.environment.stations import StationCatalog, itrs_to_geodetic, topocentric

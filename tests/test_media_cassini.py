@@ -15,6 +15,7 @@ from odpipe.media.apply import calibrate
 from odpipe.media.model import MediaModel
 from odpipe.time.scales import utc_to_tdb
 from parsers import odf
+from parsers.ramps import RampStore
 from parsers.trk223 import read_trk223
 
 pytestmark = pytest.mark.realdata
@@ -51,10 +52,11 @@ def test_ion_card_windows_are_rise_to_set(shared_data, saturn_itrs):
 
 def test_calibrate_cassini_odf(shared_data, saturn_itrs):
     d = shared_data / "cassini"
-    table = odf.read(d / "S18TIGM2006_058_0005X25MV1.ODF").table
+    data = odf.read(d / "S18TIGM2006_058_0005X25MV1.ODF")
+    table = data.table
     table = table[(table["observable"] == "range") | (np.arange(len(table)) % 50 == 0)].reset_index(drop=True)
     cal = read_trk223(d / "S18TIGE2006_032_2006_059.TRO", d / "S18TIGE2006_032_2006_059.ION")
-    out, report = calibrate(table, MediaModel(cal), target_itrs=saturn_itrs, order=None)
+    out, report = calibrate(table, MediaModel(cal), target_itrs=saturn_itrs, ramps=data.ramps, order=None)
     two_way = out[out["observable"] != "doppler_3way"]
     assert np.isfinite(two_way["media_m"]).all()
     assert two_way["media_source"].str.contains(r"\.TRO:\d+ .*\| iono: .*\.ION:\d+").all()
@@ -72,9 +74,12 @@ def test_calibrate_cassini_odf(shared_data, saturn_itrs):
     st = StationCatalog.default()["DSS-25"]
     rtlt = 2 * np.linalg.norm(saturn_itrs(t_rx) - st.position_itrs(t_rx[None]), axis=-1)[0] / C_LIGHT
     t_tx = t_rx - np.timedelta64(int(round(rtlt * 1e9)), "ns")
-    f_up = 7.16e9                   # ramped X uplink: nominal X; downlink through the 880/749 turnaround
+    f_up = RampStore(data.ramps).frequency("DSS-25", t_tx[None])[0]   # ramped uplink at transmission
+    assert 7.1e9 < f_up < 7.2e9
     expected = card(t_rx) * (2295e6 / (f_up * 880 / 749)) ** 2 + card(t_tx) * (2295e6 / f_up) ** 2
     assert row["iono_m"] == pytest.approx(expected, rel=1e-9)
+    # range units: F = 221/(749*2) for an X-band uplink (Moyer ch. 13) times the uplink at transmission
+    assert row["media_ru"] == pytest.approx(row["media_m"] / C_LIGHT * f_up * 221 / 1498, rel=1e-9)
     # Saturn from Goldstone, both legs above ~10 deg: a few metres of troposphere per leg
     assert 4.0 < row["tropo_m"] < 30.0
     assert len(report) == out["pass_id"].nunique()

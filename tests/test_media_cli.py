@@ -1,6 +1,5 @@
 """``odpipe calibrate`` end to end on a synthetic table with the real Cassini calibration files."""
 
-import numpy as np
 import pandas as pd
 import pytest
 

@@ -83,7 +83,8 @@ def test_trig_series_and_additive_cards():
 
 
 @pytest.mark.parametrize("card, words", [
-    ("ADJUST(ALL) BY NRMPOW(0.1, x2) MODEL(DRY NUPART) FROM(06/01/01,00:00) TO(06/01/02,00:00) DSN(C10).", "coefficient"),
+    ("ADJUST(ALL) BY NRMPOW(0.1, x2) MODEL(DRY NUPART) FROM(06/01/01,00:00) TO(06/01/02,00:00) DSN(C10).",
+     "coefficient"),
     ("ADJUST(ALL) BY SPLINE(0.1) MODEL(DRY NUPART) FROM(06/01/01,00:00) TO(06/01/02,00:00) DSN(C10).", "SPLINE"),
     ("ADJUST(ALL) BY NRMPOW(0.1) MODEL(DRY NUPART) FROM(06/01/01,00:00) DSN(C10).", "FROM and TO"),
     ("ADJUST(ALL) BY CONST(0.1) MODEL(DRY NUPART) FROM(06/13/01,00:00) TO(06/01/02,00:00) DSN(C10).", "month"),

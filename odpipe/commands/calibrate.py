@@ -16,6 +16,7 @@ def add_arguments(parser) -> None:
     parser.add_argument("--tro", action="append", default=[], help="TRK-2-23 troposphere file (repeatable)")
     parser.add_argument("--ion", action="append", default=[], help="TRK-2-23 ionosphere file (repeatable)")
     parser.add_argument("--ionex", action="append", default=[], help="IONEX file (repeatable, combined in time)")
+    parser.add_argument("--ramps", help="uplink ramp table .parquet travelling beside the table")
     parser.add_argument("--stations", help="extra station CSV for the catalog")
     parser.add_argument("--order", type=int, default=10, help="per-pass smoothing polynomial order (-1: none)")
     parser.add_argument("-o", "--output", required=True, help="output .parquet (written atomically)")
@@ -38,7 +39,8 @@ def run(args) -> int:
     catalog = StationCatalog.default()
     if args.stations:
         catalog = catalog.with_csv(args.stations)
-    out, report = calibrate(table, model, catalog=catalog, order=None if args.order < 0 else args.order)
+    ramps = pd.read_parquet(args.ramps) if args.ramps else None
+    out, report = calibrate(table, model, catalog=catalog, ramps=ramps, order=None if args.order < 0 else args.order)
     _write_atomic(out, Path(args.output))
     if args.report:
         report.to_csv(args.report, index=False)

@@ -10,8 +10,8 @@ delay itself. Columns added:
 - ``tropo_m``, ``iono_m``, ``media_m`` (sum): m of path delay (range rows),
   m of delay change over the count interval (Doppler rows; the range-rate
   equivalent is ``media_m / count_time``). Subtract from the observable.
-- ``media_ru``: ``media_m`` of range rows in range units (NaN when the
-  uplink frequency is not known at the row, e.g. ramped).
+- ``media_ru``: ``media_m`` of range rows in range units, from the uplink
+  frequency at transmission (row value or ramp; NaN when neither is known).
 - ``media_source`` / ``media_source_up``: which file and card (or model)
   gave the downlink / uplink values; ``media_note``: why a fallback was used.
 
@@ -32,6 +32,7 @@ from odpipe.environment.stations import StationCatalog, itrs_to_geodetic, topoce
 from odpipe.measurements.bands import C_LIGHT, range_unit_factor
 from odpipe.media.model import MediaModel
 from odpipe.media.smoothing import smooth_by_group
+from odpipe.preprocess import ramp_segments
 from odpipe.preprocess.passes import assign_passes
 from odpipe.preprocess.timetags import interval_bounds
 
@@ -42,9 +43,13 @@ TWO_LEG = ("range", "doppler_2way", "doppler_3way")
 GROUND = TWO_LEG + ("doppler_1way",)
 
 
-def calibrate(table: pd.DataFrame, model: MediaModel, *, target_itrs=None,
+def calibrate(table: pd.DataFrame, model: MediaModel, *, target_itrs=None, ramps=None,
               catalog: StationCatalog | None = None, order: int | None = 10):
-    """(table with media columns, per-pass coverage report); ``order=None`` disables smoothing."""
+    """(table with media columns, per-pass coverage report).
+
+    ``ramps``: the uplink ramp table (or RampStore) beside the table, giving ramped rows their
+    uplink frequency at transmission; ``order=None`` disables per-pass smoothing.
+    """
     catalog = catalog or StationCatalog.default()
     out = table.copy()
     if (out["pass_id"] < 0).all() and len(out):
@@ -59,7 +64,7 @@ def calibrate(table: pd.DataFrame, model: MediaModel, *, target_itrs=None,
     rtlt, rtlt_note = _round_trip(out, target_itrs, catalog, epoch)
 
     samples = []      # (row, leg, instant sign, station, ground time ns, frequency Hz)
-    f_up, f_down = _frequencies(out)
+    f_up, f_down, f_up_known = _frequencies(out, epoch - np.rint(rtlt * 1e9).astype(np.int64), ramps)
     for leg, stations, freq, legs_rows in (("down", out["station_rx"], f_down, ground),
                                            ("up", out["station_tx"], f_up, ground & np.isin(obs, TWO_LEG))):
         delay_ns = np.rint(rtlt * 1e9).astype(np.int64) if leg == "up" else 0
@@ -87,7 +92,7 @@ def calibrate(table: pd.DataFrame, model: MediaModel, *, target_itrs=None,
     out["media_m"] = out["tropo_m"] + out["iono_m"]
     is_range = obs == "range"
     bands, band_idx = np.unique(out["band_up"].to_numpy(dtype=str), return_inverse=True)
-    f_ru = out["uplink_hz"].to_numpy(dtype=float) * range_unit_factor(bands)[band_idx]
+    f_ru = f_up_known * range_unit_factor(bands)[band_idx]
     out["media_ru"] = np.where(is_range, out["media_m"].to_numpy() / C_LIGHT * f_ru, np.nan)
     code, texts = pd.factorize("tropo: " + pd.Series(lab_t) + " | iono: " + pd.Series(lab_i))
     texts = np.append(np.asarray(texts, dtype=object), "")
@@ -101,9 +106,14 @@ def calibrate(table: pd.DataFrame, model: MediaModel, *, target_itrs=None,
     return out, pass_report(out)
 
 
-def _frequencies(t: pd.DataFrame):
-    """(uplink Hz, downlink Hz) per row: table values, turnaround, else nominal band frequency."""
-    up = t["uplink_hz"].to_numpy(dtype=float)
+def _frequencies(t: pd.DataFrame, tx_ns, ramps):
+    """(uplink Hz, downlink Hz) per row: table value or ramp at transmission, turnaround, else nominal."""
+    up = t["uplink_hz"].to_numpy(dtype=float).copy()
+    store = ramp_segments.store(ramps)
+    ramped = t["ramped"].to_numpy(dtype=bool) & np.isnan(up)
+    if store is not None and ramped.any():
+        tx_station = t["station_tx"].to_numpy(dtype=object)[ramped]
+        up[ramped] = store.frequency(tx_station, tx_ns[ramped].view("datetime64[ns]"))
     nominal = {}
     for leg, col in (("up", "band_up"), ("down", "band_down")):
         bands, idx = np.unique(t[col].to_numpy(dtype=str), return_inverse=True)
@@ -112,7 +122,7 @@ def _frequencies(t: pd.DataFrame):
     one_way = t["observable"].to_numpy(dtype=object) == "doppler_1way"
     turned = f_up * t["transponder_ratio"].to_numpy(dtype=float)
     f_down = np.where(one_way & np.isfinite(up), up, np.where(np.isfinite(turned), turned, nominal["down"]))
-    return f_up, f_down
+    return f_up, f_down, up
 
 
 def _round_trip(t: pd.DataFrame, target_itrs, catalog, epoch_ns):
