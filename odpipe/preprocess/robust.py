@@ -63,15 +63,15 @@ def _chunks(t_s: np.ndarray, group: np.ndarray, length: float) -> np.ndarray:
     return pd.DataFrame({"g": group, "p": piece}).groupby(["g", "p"], sort=False).ngroup().to_numpy()
 
 
-def _fit(powers, v, w, chunk, n_chunks, degree):
+def _fit(powers, v, w, starts, chunk, degree):
     """Weighted least-squares polynomial per chunk (batched normal equations); fitted values.
 
-    ``powers`` holds x**0 .. x**(2 degree) per row.
+    Rows are sorted by chunk, chunk i starting at row ``starts[i]``; ``powers``
+    holds x**0 .. x**(2 degree) per row.
     """
-    s = np.stack([np.bincount(chunk, weights=w * powers[:, j], minlength=n_chunks)
-                  for j in range(2 * degree + 1)], axis=1)
-    b = np.stack([np.bincount(chunk, weights=w * powers[:, j] * v, minlength=n_chunks)
-                  for j in range(degree + 1)], axis=1)
+    wp = powers * w[:, None]
+    s = np.add.reduceat(wp, starts, axis=0)
+    b = np.add.reduceat(wp[:, :degree + 1] * v[:, None], starts, axis=0)
     idx = np.arange(degree + 1)
     normal = s[:, idx[:, None] + idx[None, :]]
     ridge = 1e-10 * (s[:, :1, None] + 1.0) * np.eye(degree + 1)
@@ -90,19 +90,23 @@ def robust_detrend(t_s: np.ndarray, values: np.ndarray, group: np.ndarray, *, us
     t = np.asarray(t_s, dtype=float)
     v = np.asarray(values, dtype=float)
     use = np.ones(len(v), dtype=bool) if use is None else np.asarray(use, dtype=bool)
+    resid, inlier = np.zeros(len(v)), np.zeros(len(v), dtype=bool)
+    if len(v) == 0:
+        return resid, inlier
     chunk = _chunks(t, np.asarray(group), piece)
-    n_chunks = int(chunk.max()) + 1 if len(chunk) else 0
-    cs = pd.Series(chunk)
-    t0 = cs.map(pd.Series(t).groupby(chunk).min()).to_numpy()
-    t1 = cs.map(pd.Series(t).groupby(chunk).max()).to_numpy()
+    order = np.argsort(chunk, kind="stable")
+    chunk, t, v, use = chunk[order], t[order], v[order], use[order]
+    starts = np.flatnonzero(np.r_[True, chunk[1:] != chunk[:-1]])
+    t0 = np.minimum.reduceat(t, starts)[chunk]
+    t1 = np.maximum.reduceat(t, starts)[chunk]
     x = np.where(t1 > t0, 2 * (t - t0) / np.where(t1 > t0, t1 - t0, 1.0) - 1, 0.0)
-    centre = cs.map(pd.Series(v[use]).groupby(chunk[use]).median()).to_numpy()
-    centre = np.nan_to_num(centre)
-    y = v - centre
-    inlier = use & (np.abs(y) <= 10 * np.nan_to_num(mad_sigma(v, chunk, use), nan=np.inf) + 1e-300)
-    powers = x[:, None] ** np.arange(2 * degree + 1)
+    centre = pd.Series(chunk).map(pd.Series(v[use]).groupby(chunk[use]).median()).to_numpy()
+    y = v - np.nan_to_num(centre)
+    inl = use & (np.abs(y) <= 10 * np.nan_to_num(mad_sigma(v, chunk, use), nan=np.inf) + 1e-300)
+    powers = np.vander(x, 2 * degree + 1, increasing=True)
     for _ in range(iterations):
-        resid = y - _fit(powers, np.where(inlier, y, 0.0), inlier.astype(float), chunk, n_chunks, degree)
-        sig = mad_sigma(resid, chunk, inlier)
-        inlier = use & (np.abs(resid) <= k * np.nan_to_num(sig, nan=np.inf))
+        res = y - _fit(powers, np.where(inl, y, 0.0), inl.astype(float), starts, chunk, degree)
+        sig = mad_sigma(res, chunk, inl)
+        inl = use & (np.abs(res) <= k * np.nan_to_num(sig, nan=np.inf))
+    resid[order], inlier[order] = res, inl
     return resid, inlier
