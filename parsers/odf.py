@@ -96,16 +96,18 @@ def sniff(head: bytes) -> bool:
     return bool(w[0] == LABEL and w[1] == 0 and w[2] == 1 and w[3] == 0 and not w[4:].any())
 
 
+def code_labels(codes: np.ndarray, label) -> np.ndarray:
+    """Object array of ``label(code)`` for integer codes, computed once per distinct code."""
+    uniq, inverse = np.unique(np.asarray(codes, dtype=np.int64), return_inverse=True)
+    return np.array([label(int(c)) for c in uniq], dtype=object)[inverse.ravel()]
+
+
 def station_names(ids: np.ndarray, network: np.ndarray | int = 0) -> np.ndarray:
     """'DSS-nn' for DSN ids (network 0), 'NETk-nn' for other networks, '' for id 0."""
     ids = np.asarray(ids, dtype=np.int64)
     net = np.broadcast_to(np.asarray(network, dtype=np.int64), ids.shape)
-    out = np.empty(ids.shape, dtype=object)
-    for key in set(zip(ids.tolist(), net.tolist())):
-        sid, k = key
-        name = "" if sid == 0 else (f"DSS-{sid:02d}" if k == 0 else f"NET{k}-{sid:02d}")
-        out[(ids == sid) & (net == k)] = name
-    return out
+    return code_labels(net * 128 + ids, lambda c: "" if c % 128 == 0 else
+                       f"DSS-{c % 128:02d}" if c < 128 else f"NET{c // 128}-{c % 128:02d}")
 
 
 def transponder_ratio(band_up: np.ndarray, band_down: np.ndarray) -> np.ndarray:
@@ -253,7 +255,7 @@ def _orbit_data(path, words, idx, errors, report) -> pd.DataFrame:
         unit=_UNIT[dtype_id],
         count_time=np.where(counted, item21 * 0.01, 0.0),
         station_tx=station_names(tx), station_rx=station_names(rx, net),
-        spacecraft=scid.astype(str).astype(object), band_up=band_up, band_down=band_down,
+        spacecraft=code_labels(scid, str), band_up=band_up, band_down=band_down,
         uplink_hz=ref_hz, transponder_ratio=ratio, source=str(path), record=idx.astype(np.int64),
         flags=0,
         odf_data_type=dtype_id, validity=(w4 & 1).astype(np.int64), network_id=net,

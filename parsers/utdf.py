@@ -26,8 +26,11 @@ validity bit or a non-zero field): ``range`` as round-trip delay in s,
 Doppler as the Doppler shift in Hz = (delta count / delta t - 240 MHz bias) / M
 between consecutive records of one vehicle and pad (or count / interval for
 destruct Doppler; NaN for the first of a series), angles in rad. Extra
-columns keep every field; ``meta["records"]`` holds the records field by field
-and :func:`write` turns such a frame back into bytes, bit for bit.
+columns: ``valid`` (the row's validity bit), ``validity`` (the byte), ``vid``,
+``tracker_type``, ``band_code``, ``data_interval_s``, ``doppler_count`` and
+``factor_m`` (Doppler rows). ``meta["records"]`` holds every field of every
+record (AGC, mode, antenna types, router, TDRSS-only bytes, ...; join on
+``record``) and :func:`write` turns such a frame back into bytes, bit for bit.
 """
 
 from __future__ import annotations
@@ -40,6 +43,7 @@ import pandas as pd
 
 from parsers import table as tt
 from parsers.errors import ParseError, ParseReport, handle
+from parsers.odf import code_labels
 from parsers.table import TrackingData
 
 RECORD = 75
@@ -118,7 +122,8 @@ def records_frame(raw: np.ndarray, index: np.ndarray) -> pd.DataFrame:
     df["doppler_count"] = (raw["doppler_hi"].astype(np.int64) << 16) | raw["doppler_lo"]
     for name in ("front", "tdrss", "rear"):
         df[name] = raw[name].astype(object)
-    df["router"] = np.char.decode(raw["router"], "latin-1").astype(object)
+    routers, inverse = np.unique(raw["router"], return_inverse=True)
+    df["router"] = np.array([r.decode("latin-1") for r in routers], dtype=object)[inverse.ravel()]
     return df[RECORD_FIELDS]
 
 
@@ -176,13 +181,19 @@ def data_interval(tracker_and_interval: np.ndarray) -> np.ndarray:
     return np.where(v & 0x400, 1.0 / rate, v.astype(float))
 
 
+KINDS = ("range", "doppler", "angle1", "angle2")
+UNITS = np.array(["s", "Hz", "rad", "rad"], dtype=object)
+TAGS = np.array(["receive", "interval_end", "receive", "receive"], dtype=object)
+
+
 def _table(rec: pd.DataFrame, source: str) -> pd.DataFrame:
-    """TrackingTable rows (range, Doppler, two angles) from the records frame."""
+    """TrackingTable rows (range, Doppler, two angles, in this order per record) from the records."""
     n = len(rec)
-    valid = rec["validity"].to_numpy().astype(np.int64)
-    band = (rec["band_and_type"].to_numpy() >> 4).astype(np.int64)
-    tx_hz = rec["transmit_freq_10hz"].to_numpy().astype(np.int64) * 10.0
-    tracker = rec["tracker_and_interval"].to_numpy().astype(np.int64)
+    col = {name: rec[name].to_numpy() for name in rec.columns}
+    valid = col["validity"].astype(np.int64)
+    band = (col["band_and_type"] >> 4).astype(np.int64)
+    tx_hz = col["transmit_freq_10hz"].astype(np.int64) * 10.0
+    tracker = col["tracker_and_interval"].astype(np.int64)
     interval = data_interval(tracker)
     up = np.array([BANDS.get(b, ("", ""))[0] for b in range(16)], dtype=object)[band]
     down = np.array([BANDS.get(b, ("", ""))[1] for b in range(16)], dtype=object)[band]
@@ -190,79 +201,64 @@ def _table(rec: pd.DataFrame, source: str) -> pd.DataFrame:
     factor_m = np.where((band == 6) | (band == 8) | (tx_hz >= 12e9), 100.0, 1000.0)
     factor_k = np.where(s_band, 240 / 221, np.where(band == 1, 1.0, np.nan))
     epoch = epochs(rec)
-    rng = rec["range_delay"].to_numpy()
-    cnt = rec["doppler_count"].to_numpy()
-    a1, a2 = rec["angle1"].to_numpy().astype(float), rec["angle2"].to_numpy().astype(float)
-    geometry = (rec["rx_antenna_type"].to_numpy() & 0x0F).astype(np.int64)
-    names = [np.array([GEOMETRY.get(g, ("angle_1", "angle_2"))[k] for g in range(16)], dtype=object)[geometry]
-             for k in (0, 1)]
-
-    doppler_hz, count_time = _doppler(rec, cnt, valid, interval, factor_m, epoch)
+    rng, cnt = col["range_delay"], col["doppler_count"]
+    a1, a2 = col["angle1"].astype(float), col["angle2"].astype(float)
+    doppler_hz, count_time = _doppler(col, cnt, valid, interval, factor_m, epoch)
+    geometry = (col["rx_antenna_type"] & 0x0F).astype(np.int64)
+    angle_names = [np.array([GEOMETRY.get(g, ("angle_1", "angle_2"))[k] for g in range(16)],
+                            dtype=object)[geometry] for k in (0, 1)]
     two_way = tx_hz > 0
-    parts = {
-        "range": ((valid & 1).astype(bool) | (rng != 0), rng / 256e9, "s", np.zeros(n), valid & 1),
-        "doppler": ((valid & 2).astype(bool) | (cnt != 0), doppler_hz, "Hz", count_time, (valid >> 1) & 1),
-        "angle1": ((valid & 4).astype(bool) | (a1 != 0), a1 / 2**32 * TWO_PI, "rad", np.zeros(n), (valid >> 2) & 1),
-        "angle2": ((valid & 4).astype(bool) | (a2 != 0), _signed_half_turn(a2 / 2**32 * TWO_PI), "rad",
-                   np.zeros(n), (valid >> 2) & 1),
-    }
-    observable = {"range": np.full(n, "range", dtype=object),
-                  "doppler": np.where(two_way, "doppler_2way", "doppler_1way").astype(object),
-                  "angle1": names[0], "angle2": names[1]}
-    tag = {"range": "receive", "doppler": "interval_end", "angle1": "receive", "angle2": "receive"}
-    frames = []
-    for kind, (present, value, unit, ctime, bit) in parts.items():
-        rows = np.flatnonzero(present)
-        frames.append(pd.DataFrame({"_order": rows * 4 + list(parts).index(kind), "_rows": rows,
-                                    "_kind": kind, "value": value[rows], "unit": unit,
-                                    "count_time": ctime[rows], "observable": observable[kind][rows],
-                                    "tag": tag[kind], "valid": bit[rows].astype(bool)}))
-    rows = pd.concat(frames, ignore_index=True).sort_values("_order", kind="stable")
-    r = rows["_rows"].to_numpy()
-    tx_pad = rec["tx_pad"].to_numpy()
-    sic = rec["sic"].to_numpy()
-    is_doppler = (rows["_kind"] == "doppler").to_numpy()
+
+    bits = np.stack([valid & 1, (valid >> 1) & 1, (valid >> 2) & 1, (valid >> 2) & 1], axis=1).astype(bool)
+    present = bits | np.stack([rng != 0, cnt != 0, a1 != 0, a2 != 0], axis=1)
+    value = np.stack([rng / 256e9, doppler_hz, a1 / 2**32 * TWO_PI,
+                      _signed_half_turn(a2 / 2**32 * TWO_PI)], axis=1)
+    ctime = np.stack([np.zeros(n), count_time, np.zeros(n), np.zeros(n)], axis=1)
+    doppler_name = np.where(two_way, "doppler_2way", "doppler_1way").astype(object)
+    names = np.stack([np.full(n, "range", dtype=object), doppler_name, *angle_names], axis=1)
+    flat = present.ravel()
+    r = np.repeat(np.arange(n), len(KINDS))[flat]
+    k = np.tile(np.arange(len(KINDS)), n)[flat]
+    is_doppler = k == 1
     return tt.build(
-        len(rows), epoch=epoch[r], tag=rows["tag"].to_numpy(), observable=rows["observable"].to_numpy(),
-        value=rows["value"].to_numpy(), unit=rows["unit"].to_numpy(),
-        count_time=rows["count_time"].to_numpy(),
-        station_tx=np.where(two_way[r], _pads(tx_pad[r]), "").astype(object),
-        station_rx=_pads(rec["rx_pad"].to_numpy()[r]),
-        spacecraft=sic[r].astype(str).astype(object),
+        len(r), epoch=epoch[r], tag=TAGS[k], observable=names.ravel()[flat], value=value.ravel()[flat],
+        unit=UNITS[k], count_time=ctime.ravel()[flat],
+        station_tx=np.where(two_way[r], _pads(col["tx_pad"][r]), "").astype(object),
+        station_rx=_pads(col["rx_pad"][r]), spacecraft=code_labels(col["sic"][r], str),
         band_up=np.where(two_way[r], up[r], "").astype(object), band_down=down[r],
         uplink_hz=np.where(two_way[r], tx_hz[r], np.nan),
         transponder_ratio=np.where(two_way[r], factor_k[r], np.nan),
         source=source, record=rec.index.to_numpy()[r].astype(np.int64), flags=0,
-        valid=rows["valid"].to_numpy(), vid=rec["vid"].to_numpy()[r].astype(np.int64),
-        validity=valid[r], tracker_type=(tracker[r] >> 12), last_frame=((tracker[r] >> 11) & 1).astype(bool),
-        data_interval_s=interval[r], band_code=band[r],
-        transmission_type=(rec["band_and_type"].to_numpy()[r] & 0x0F).astype(np.int64),
-        mode=rec["mode"].to_numpy()[r].astype(np.int64), agc=rec["agc"].to_numpy()[r].astype(np.int64),
-        tx_antenna_type=rec["tx_antenna_type"].to_numpy()[r].astype(np.int64),
-        rx_antenna_type=rec["rx_antenna_type"].to_numpy()[r].astype(np.int64),
-        doppler_count=np.where(is_doppler, cnt[r], -1),
-        doppler_bias_hz=np.where(is_doppler, DOPPLER_BIAS_HZ, np.nan),
+        valid=bits.ravel()[flat], validity=valid[r], vid=col["vid"][r], tracker_type=tracker[r] >> 12,
+        band_code=band[r], data_interval_s=interval[r], doppler_count=np.where(is_doppler, cnt[r], -1),
         factor_m=np.where(is_doppler, factor_m[r], np.nan),
-        router=rec["router"].to_numpy()[r], tdrss=rec["tdrss"].to_numpy()[r],
     )
 
 
-def _doppler(rec, cnt, valid, interval, factor_m, epoch):
-    """Doppler shift (Hz) and count time (s) per record from the running or destruct count."""
+def _doppler(col, cnt, valid, interval, factor_m, epoch):
+    """Doppler shift (Hz) and count time (s) per record from the running or destruct count.
+
+    A running count is differenced with the previous record of the same SIC,
+    VID and receive pad that carries one.
+    """
     has = ((valid & 2) != 0) | (cnt != 0)
     destruct = (valid & 64) != 0
-    series = pd.factorize(pd.MultiIndex.from_arrays([rec["sic"].to_numpy(), rec["vid"].to_numpy(),
-                                                     rec["rx_pad"].to_numpy(), has & ~destruct]))[0]
-    prev = pd.Series(np.arange(len(rec))).groupby(series).shift(1).to_numpy()
-    has_prev = ~np.isnan(prev) & has & ~destruct
-    p = np.where(has_prev, prev, 0).astype(np.int64)
+    running = has & ~destruct
+    key = ((col["sic"].astype(np.int64) * 65536 + col["vid"]) * 256 + col["rx_pad"]) * 2 + running
+    order = np.argsort(key, kind="stable")
+    same = np.concatenate(([False], key[order][1:] == key[order][:-1]))
+    prev = np.full(len(key), -1)
+    prev[order] = np.where(same, np.concatenate(([-1], order[:-1])), -1)
+    has_prev = (prev >= 0) & running
+    p = np.where(has_prev, prev, 0)
     dt = (epoch - epoch[p]).astype(np.int64) / 1e9
     dn = (cnt - cnt[p]) % COUNT_WRAP
+    ok = has_prev & (dt > 0)
     with np.errstate(invalid="ignore", divide="ignore"):
-        running = (dn / dt - DOPPLER_BIAS_HZ) / factor_m
-        single = (cnt / interval - DOPPLER_BIAS_HZ) / factor_m
-    hz = np.where(destruct, single, np.where(has_prev & (dt > 0), running, np.nan))
-    count_time = np.where(destruct, interval, np.where(has_prev & (dt > 0), dt, np.nan))
+        from_running = (dn / dt - DOPPLER_BIAS_HZ) / factor_m
+        from_destruct = (cnt / interval - DOPPLER_BIAS_HZ) / factor_m
+    hz = np.where(destruct, from_destruct, np.where(ok, from_running, np.nan))
+    count_time = np.where(destruct, interval, np.where(ok, dt, np.nan))
     return hz, count_time
 
 
@@ -273,5 +269,4 @@ def _signed_half_turn(angle: np.ndarray) -> np.ndarray:
 
 def _pads(pads: np.ndarray) -> np.ndarray:
     """Station names from antenna pad ids: 'PAD-119'."""
-    names = np.array([f"PAD-{i}" for i in range(256)], dtype=object)
-    return names[pads.astype(np.int64)]
+    return code_labels(pads, lambda c: f"PAD-{c}")
