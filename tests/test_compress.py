@@ -144,19 +144,29 @@ def test_flagged_rows_pass_through_and_break_contiguity():
     assert out["n_samples"].sum() == len(tab)
 
 
-def test_accumulated_phase_is_differenced_exactly():
+@pytest.mark.parametrize("observable", ["phase_downlink", "total_phase"])
+def test_accumulated_phase_is_differenced_exactly(observable):
     t = np.arange(0.0, 601.0, 1.0)  # 601 phase samples span 600 s
     phase = truth_integral(t) - truth_integral(0.0)
     tab = build(len(t), epoch=T0 + (t * 1e9).astype("timedelta64[ns]"), tag="receive",
-                observable="phase_downlink", value=phase, unit="cycles", sigma=1e-3, count_time=0.0,
+                observable=observable, value=phase, unit="cycles", sigma=1e-3, count_time=0.0,
                 station_rx="DSS-24", spacecraft="181", band_down="X", source="synthetic",
                 record=np.arange(len(t)), flags=0)
     out, rep = compress(tab, 60.0)
     assert rep.phase_rows == 10 and len(rep.dropped) == 0
-    assert (out["observable"] == "phase_downlink_rate").all() and (out["unit"] == "Hz").all()
+    assert (out["observable"] == observable + "_rate").all() and (out["unit"] == "Hz").all()
     assert np.allclose(out["count_time"], 60.0)
     assert np.max(np.abs(out["value"].to_numpy() - window_truth(out))) < 1e-6
     assert list(out["source_records"].iloc[1]) == list(range(60, 121))
+
+
+def test_doppler_counts_add_up():
+    t = np.arange(0.5, 600.0, 1.0)
+    tab = doppler_table(t, observable="doppler_count_2way", unit="cycles")  # cycles in each 1-s count
+    out, _ = compress(tab, 60.0)
+    mid = (out["epoch"] - T0).dt.total_seconds().to_numpy()
+    exact = truth_integral(mid + 30) - truth_integral(mid - 30)  # cycles in each 60-s count
+    assert len(out) == 10 and np.max(np.abs(out["value"].to_numpy() - exact)) < 1e-5
 
 
 def test_other_observables_pass_through():

@@ -2,11 +2,13 @@
 
 * Count-averaged Doppler (``doppler_*``, ``range_rate``, ``sst_doppler`` with a
   count time): N back-to-back count intervals average, weighted by their count
-  times, to exactly the count-averaged Doppler over their union.
-* Accumulated phase (``phase_*`` in cycles, e.g. TRK-2-34 total count phase or
-  UTDF Doppler counters): the difference of phase at the ends of a window over
-  its length is exactly the mean frequency (Hz) over it; the row becomes
-  ``<observable>_rate`` tagged at the middle of the interval.
+  times, to exactly the count-averaged Doppler over their union. Doppler
+  counts in cycles (TRK-2-34 ``doppler_count_*``) add up instead.
+* Accumulated phase (``phase_*``, ``total_phase`` in cycles with no count time,
+  e.g. TRK-2-34 carrier and total count phase): the difference of phase at the
+  ends of a window over its length is exactly the mean frequency (Hz) over it;
+  the row becomes ``<observable>_rate`` tagged at the middle of the interval.
+  (UTDF counters arrive already differenced into Hz by the UTDF reader.)
 
 Windows never span a gap, an overlap, a pass, an uplink ramp segment or a source
 file. Each segment's windows start at its first sample, so only a segment's last
@@ -62,8 +64,10 @@ def _is_averaged(df: pd.DataFrame) -> np.ndarray:
 
 
 def _is_phase(df: pd.DataFrame) -> np.ndarray:
-    return (df["observable"].astype(str).str.startswith("phase").to_numpy()
-            & (df["unit"].to_numpy() == "cycles") & (df["flags"].to_numpy() == 0))
+    obs = df["observable"].astype(str)
+    return ((obs.str.startswith("phase") | (obs == "total_phase")).to_numpy()
+            & (df["unit"].to_numpy() == "cycles") & (df["count_time"].fillna(0).to_numpy() == 0)
+            & (df["flags"].to_numpy() == 0))
 
 
 def _segments(df: pd.DataFrame, start, end, ramps, tol_ns, contiguous: bool):
@@ -116,9 +120,11 @@ def _compress_averaged(df, ramps, count_ns, tol_ns):
     v = sub["value"].to_numpy(dtype=float)
     ref = v[first][grp]  # subtract each window's first value: sums stay precise
     total_ct = np.bincount(grp, weights=ct, minlength=ng)
-    value = v[first] + np.bincount(grp, weights=(v - ref) * ct, minlength=ng) / total_ct
+    counted = sub["unit"].to_numpy()[first] == "cycles"  # Doppler counts add up; frequencies average
+    mean = v[first] + np.bincount(grp, weights=(v - ref) * ct, minlength=ng) / total_ct
+    value = np.where(counted, np.bincount(grp, weights=v, minlength=ng), mean)
     scatter, _ = third_difference_scatter(v, grp, ng)
-    ratio = np.sqrt(ct[first] / total_ct)
+    ratio = np.sqrt(ct[first] / total_ct) ** np.where(counted, -1, 1)
     sigma = np.where(np.isfinite(scatter), scatter, sub["sigma"].to_numpy(dtype=float)[first]) * ratio
     out = sub.iloc[first].reset_index(drop=True)
     out["epoch"] = tag_epoch(s[first], e[last], out["tag"].to_numpy()).view("datetime64[ns]")
