@@ -86,7 +86,10 @@ def body_id(body) -> int:
 
 @dataclass(frozen=True)
 class _Link:
-    """One ephemeris segment: ``target`` relative to ``center``; ``compute(jd1, jd2) -> (km, km/day)``."""
+    """One ephemeris segment: ``target`` relative to ``center``.
+
+    ``compute(jd1, jd2, velocity) -> (km, km/day or None)``.
+    """
 
     center: int
     compute: object
@@ -124,8 +127,8 @@ class Ephemeris:
         kernel = SPK.open(str(path))
         links = {}
         for seg in kernel.segments:
-            def compute(jd1, jd2, seg=seg):
-                return seg.compute_and_differentiate(jd1, jd2)
+            def compute(jd1, jd2, velocity, seg=seg):
+                return seg.compute_and_differentiate(jd1, jd2) if velocity else (seg.compute(jd1, jd2), None)
             links[seg.target] = _Link(seg.center, compute, seg.start_jd, seg.end_jd, float(seg.start_second))
         return cls(name, links, {k: v * 1e9 for k, v in gm_km3.items()})
 
@@ -138,7 +141,9 @@ class Ephemeris:
         origin = (lo - J2000_JD) * _DAY
 
         def series(name, scale=1.0):
-            def compute(jd1, jd2):
+            def compute(jd1, jd2, velocity):
+                if not velocity:
+                    return scale * eph.position(name, jd1, jd2), None
                 p, v = eph.position_and_velocity(name, jd1, jd2)
                 return scale * p, scale * v
             return _Link(0, compute, lo, hi, origin)
@@ -166,9 +171,9 @@ class Ephemeris:
             chain.append(link.center)
         return chain
 
-    def _sum_to(self, chain: list[int], stop: int, jd1: np.ndarray, jd2: np.ndarray):
+    def _sum_to(self, chain: list[int], stop: int, jd1: np.ndarray, jd2: np.ndarray, velocity: bool):
         pos = np.zeros((3,) + jd2.shape)
-        vel = np.zeros((3,) + jd2.shape)
+        vel = np.zeros((3,) + jd2.shape) if velocity else None
         for body in chain:
             if body == stop:
                 break
@@ -178,25 +183,29 @@ class Ephemeris:
                 bad = lo if lo < link.jd_start else hi
                 raise ValueError(f"epoch TDB {(bad - J2000_JD) * _DAY:.3f} s past J2000 (JD {bad:.5f}) is outside "
                                  f"{self.name} coverage of body {body} (JD {link.jd_start}..{link.jd_end})")
-            p, v = link.compute(jd1, jd2)
+            p, v = link.compute(jd1, jd2, velocity)
             pos += np.reshape(p, pos.shape)
-            vel += np.reshape(v, vel.shape)
+            if velocity:
+                vel += np.reshape(v, vel.shape)
         return pos, vel
 
-    def state(self, target, center, t_tdb) -> np.ndarray:
-        """State (m, m/s) of ``target`` relative to ``center`` in ICRF at TDB s past J2000: (N,6) or (6,)."""
+    def _relative(self, target, center, t_tdb, velocity: bool):
         t = np.asarray(t_tdb, dtype=float)
         jd1, jd2 = jd_split(t)
         a, b = self._chain(body_id(target)), self._chain(body_id(center))
         common = next(x for x in a if x in b)
-        pa, va = self._sum_to(a, common, jd1, jd2)
-        pb, vb = self._sum_to(b, common, jd1, jd2)
-        out = np.concatenate([(pa - pb) * 1e3, (va - vb) * (1e3 / _DAY)]).T
-        return out.reshape(t.shape + (6,))
+        pa, va = self._sum_to(a, common, jd1, jd2, velocity)
+        pb, vb = self._sum_to(b, common, jd1, jd2, velocity)
+        parts = [(pa - pb) * 1e3] + ([(va - vb) * (1e3 / _DAY)] if velocity else [])
+        return np.concatenate(parts).T.reshape(t.shape + (3 * len(parts),))
+
+    def state(self, target, center, t_tdb) -> np.ndarray:
+        """State (m, m/s) of ``target`` relative to ``center`` in ICRF at TDB s past J2000: (N,6) or (6,)."""
+        return self._relative(target, center, t_tdb, velocity=True)
 
     def position(self, target, center, t_tdb) -> np.ndarray:
         """Position (m) of ``target`` relative to ``center`` in ICRF: (N,3) or (3,)."""
-        return self.state(target, center, t_tdb)[..., :3]
+        return self._relative(target, center, t_tdb, velocity=False)
 
     def gm(self, body) -> float:
         """Gravitational parameter (m^3/s^2) of ``body`` as adopted by this ephemeris."""

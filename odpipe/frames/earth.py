@@ -18,7 +18,7 @@ import erfa
 import numpy as np
 
 from odpipe.environment.eop import EOPValues, eop_at
-from odpipe.environment.interpolation import lagrange4_uniform
+from odpipe.environment.interpolation import on_uniform_grid
 from odpipe.frames.epochs import utc_and_tt
 from odpipe.time.leap_seconds import NS_PER_DAY
 from odpipe.time.scales import J2000_JD, J2000_NS
@@ -51,16 +51,8 @@ def _cip_xys_direct(tt_days: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.nda
 
 def cip_xys(tt_days) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """CIP X, Y and CIO locator s (rad) of IAU 2006/2000A at TT days past J2000 (no dX/dY)."""
-    tt = np.asarray(tt_days, dtype=float)
-    if tt.size < _CIP_GRID_MIN_EPOCHS:
-        return _cip_xys_direct(tt)
-    lo = np.floor(tt.min() / CIP_GRID_STEP_DAYS) * CIP_GRID_STEP_DAYS - CIP_GRID_STEP_DAYS
-    n = int(np.ceil((tt.max() - lo) / CIP_GRID_STEP_DAYS)) + 2
-    if n >= tt.size // 2:
-        return _cip_xys_direct(tt)
-    nodes = lo + CIP_GRID_STEP_DAYS * np.arange(max(n, 4))
-    grid = np.stack(_cip_xys_direct(nodes), axis=-1)
-    v = lagrange4_uniform(lo, CIP_GRID_STEP_DAYS, grid, tt.ravel()).reshape(tt.shape + (3,))
+    v = on_uniform_grid(lambda d: np.stack(_cip_xys_direct(d), axis=-1), tt_days, CIP_GRID_STEP_DAYS,
+                        _CIP_GRID_MIN_EPOCHS)
     return v[..., 0], v[..., 1], v[..., 2]
 
 
