@@ -48,7 +48,8 @@ def _leg(model, st, t, f, phase):
     lat, lon, h = itrs_to_geodetic(st.r_itrs)
     az, el, _ = topocentric(st, target(t), t)
     trop, _ = model.troposphere("DSS-25", t, el, lat, h)
-    ion, _ = model.ionosphere("DSS-25", "82", t, el, az, lat, lon, np.full(t.shape, f))
+    lat_c = np.arctan2(st.r_itrs[2], np.hypot(st.r_itrs[0], st.r_itrs[1]))     # geocentric
+    ion, _ = model.ionosphere("DSS-25", "82", t, el, az, lat_c, lon, np.full(t.shape, f))
     return trop + (-ion if phase else ion)
 
 

@@ -113,3 +113,27 @@ def test_pierce_point_thin_shell():
     lat, lon, ob = pierce_point(0.3, 1.0, 0.0, e, 6371e3, 350e3)
     assert lat == pytest.approx(0.3 + (np.pi / 2 - e - zp)) and lon == pytest.approx(1.0)
     assert ob == pytest.approx(1 / np.cos(zp))
+
+
+@pytest.mark.realdata
+def test_slant_delay_to_a_leo_matches_orekit(gim):
+    # Orekit GlobalIonosphereMapModelTest.testSpacecraftState: Keplerian orbit a 7187990.1979844316 m,
+    # e 0.5e-4, i 98.01, w 131.88, RAAN 252.24, true anomaly 250.00 deg (EME2000) at 2019-01-15 03:43:12 UTC,
+    # seen from Cuttack (20.5236 N, 85.7881 E, 36 m): L1 path delay 2.811 m (simple linear interpolation)
+    from odpipe.environment.stations import Station, geodetic_to_itrs, topocentric
+    from odpipe.frames.earth import gcrs_to_itrs
+
+    a, e = 7187990.1979844316, 0.5e-4
+    inc, argp, raan, nu = np.radians([98.01, 131.88, 252.24, 250.0])
+    r = a * (1 - e * e) / (1 + e * np.cos(nu))
+    u = argp + nu
+    r_eci = r * np.array([np.cos(raan) * np.cos(u) - np.sin(raan) * np.sin(u) * np.cos(inc),
+                          np.sin(raan) * np.cos(u) + np.cos(raan) * np.sin(u) * np.cos(inc),
+                          np.sin(u) * np.sin(inc)])
+    t = np.array(["2019-01-15T03:43:12"], dtype="datetime64[ns]")
+    site = geodetic_to_itrs(np.radians(20.5236), np.radians(85.7881), 36.0)
+    az, el, _ = topocentric(Station("Cuttack", site), (gcrs_to_itrs(t)[0] @ r_eci)[None], None)
+    lat_c = np.arctan2(site[2], np.hypot(site[0], site[1]))
+    model = IonexModel(gim, time_interpolation="linear")
+    delay = group_delay(model.slant_tec(lat_c, np.radians(85.7881), az, el, t), F_L1)
+    assert delay[0] == pytest.approx(2.811, abs=1e-3)

@@ -153,6 +153,7 @@ def _leg_delays(s: pd.DataFrame, table, model: MediaModel, target_itrs, catalog)
             continue
         st = catalog[name]
         lat, lon, h = itrs_to_geodetic(st.r_itrs)
+        lat_c = np.arctan2(st.r_itrs[2], np.hypot(st.r_itrs[0], st.r_itrs[1]))     # for the spherical shell
         t = t_all[idx]
         az, el = _direction(name, t, table, target_itrs, st)
         bad = ~(el > 0.0)        # no direction, or below the horizon
@@ -160,7 +161,8 @@ def _leg_delays(s: pd.DataFrame, table, model: MediaModel, target_itrs, catalog)
         az_ok = np.where(bad, 0.0, az)
         d_t, l_t = model.troposphere(name, t, el_ok, lat, h)
         for sc, sub in pd.Series(np.arange(idx.size)).groupby(s["spacecraft"].to_numpy()[idx]).indices.items():
-            d_i, l_i = model.ionosphere(name, sc, t[sub], el_ok[sub], az_ok[sub], lat, lon, s["f"].to_numpy()[idx][sub])
+            d_i, l_i = model.ionosphere(name, sc, t[sub], el_ok[sub], az_ok[sub], lat_c, lon,
+                                        s["f"].to_numpy()[idx][sub])
             iono[idx[sub]] = np.where(bad[sub], np.nan, d_i)
             lab_i[idx[sub]] = np.where(bad[sub], "no direction", l_i)
         tropo[idx] = np.where(bad, np.nan, d_t)

@@ -93,7 +93,10 @@ class IonexModel:
                 + (1 - p) * q * g[k, j + 1, m0] + p * q * g[k, j + 1, m1])
 
     def slant_tec(self, latitude, longitude, azimuth, elevation, t_utc):
-        """Slant TEC (TECU) from a site (geodetic lat/lon rad) along az/el (rad) at UTC times."""
+        """Slant TEC (TECU) from a site along az/el (rad) at UTC times.
+
+        The single layer is a sphere: give the site's geocentric latitude (rad) and longitude.
+        """
         m = self.maps
         plat, plon, obliquity = pierce_point(latitude, longitude, azimuth, elevation,
                                              m.base_radius_m, m.height_m[0])

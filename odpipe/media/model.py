@@ -7,9 +7,11 @@ Sources, in order of preference, with the label each value carries:
   alone where no .TRO card covers a DSN time (``"DSN-seasonal (no TRO)"``);
   the Saastamoinen standard atmosphere at the site for non-DSN stations
   (``"standard-atmosphere"``); mapped to the elevation with Niell (1996).
-- ionosphere: TRK-2-23 .ION line-of-sight cards (S-band range delay, scaled by
-  ``(f_S / f)^2``) for the spacecraft; else IONEX maps; else none (0 m,
-  labelled ``"none"``).
+- ionosphere: TRK-2-23 .ION line-of-sight cards for the spacecraft — "the
+  one-way ionospheric range delay to the spacecraft, in meters at a nominal
+  S-band frequency of 2295 MHz", one normalized polynomial per pass from rise
+  to set (TRK-2-23 product description, PDS MESSENGER RSS ION) — scaled by
+  ``(f_S / f)^2``; else IONEX maps; else none (0 m, labelled ``"none"``).
 
 Delays are group (range) delays in m along one leg; a caller wanting the
 phase delay negates the ionosphere part.
@@ -54,7 +56,10 @@ class MediaModel:
         return dry * mh + wet * mw, np.full(t.shape, "standard-atmosphere", dtype=object)
 
     def ionosphere(self, station, spacecraft, t_utc, elevation, azimuth, latitude, longitude, frequency_hz):
-        """(group delay m, source label per sample) at one station for one spacecraft."""
+        """(group delay m, source label per sample) at one station for one spacecraft.
+
+        ``latitude`` is geocentric (rad): IONEX's single layer is a sphere.
+        """
         t = np.asarray(t_utc, dtype="datetime64[ns]")
         delay = np.full(t.shape, np.nan)
         label = np.full(t.shape, "none", dtype=object)
