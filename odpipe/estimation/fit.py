@@ -56,13 +56,16 @@ class Observations:
 @dataclass(frozen=True)
 class FitOptions:
     """max_iter; block: regular grid spacing (s); edit_k: innovation-test k-sigma per
-    iteration (last value repeats; inf = off); reweight: scale each group's sigma by
+    iteration (last value repeats; inf = off), applied only once the previous
+    post-fit RMS (whitened) is below edit_gate_rms, so that a far-off first
+    reference does not reject good data; reweight: scale each group's sigma by
     its post-fit RMS; tol_dx: converged when every epoch correction < tol_dx sigma and
     the post-fit RMS changed by < tol_rms (relative)."""
 
     max_iter: int = 10
     block: float = 600.0
     edit_k: tuple = (np.inf, 10.0, 5.0)
+    edit_gate_rms: float = 3.0
     reweight: bool = False
     tol_dx: float = 1e-2
     tol_rms: float = 1e-3
@@ -118,7 +121,9 @@ def build_grid(registry, t_start, t_end, block, extra=()) -> tuple[np.ndarray, d
     return grid, steps
 
 
-def _edit_k(options, it):
+def _edit_k(options, it, prev_rms):
+    if prev_rms is not None and prev_rms > options.edit_gate_rms:
+        return np.inf
     return options.edit_k[min(it, len(options.edit_k) - 1)]
 
 
@@ -145,7 +150,7 @@ def fit(problem: Problem, obs: Observations, t_start: float, t_end: float,
         srif = SRIF.from_apriori(sig0, dx=apriori - x_ref0, n_est=n_est)
         xr = x_ref0.copy()
         refs, blocks, filt = [], [], []
-        kk = _edit_k(options, it)
+        kk = _edit_k(options, it, prev_rms)
         for k in range(K):
             for j, (idx, (m, q)) in enumerate(steps.get(k, ())):
                 new = p_after.get((k, j), m * xr[idx])

@@ -110,30 +110,46 @@ def _variational(y, G, C, out):
     out[6:] = D.ravel()
 
 
+TWOBODY, CRTBP = 0, 1
+
+
 @njit(cache=True)
-def _rk4(deriv, y0, t0, times, h, p):
+def _deriv(model, y, p, out):
+    if model == TWOBODY:
+        _twobody_deriv(y, p, out)
+    else:
+        _crtbp_deriv(y, p, out)
+
+
+@njit(cache=True)
+def _rk4(model, y0, t0, times, h, p):
     """Fixed-step RK4 from t0 through sorted ``times`` (>= t0); returns states at times."""
     out = np.empty((times.size, y0.size))
     y = y0.copy()
     t = t0
-    k1, k2, k3, k4 = (np.empty_like(y0) for _ in range(4))
+    k1 = np.empty_like(y0)
+    k2 = np.empty_like(y0)
+    k3 = np.empty_like(y0)
+    k4 = np.empty_like(y0)
     for i in range(times.size):
         while t < times[i]:
             dt = min(h, times[i] - t)
-            deriv(y, p, k1)
-            deriv(y + 0.5 * dt * k1, p, k2)
-            deriv(y + 0.5 * dt * k2, p, k3)
-            deriv(y + dt * k3, p, k4)
+            _deriv(model, y, p, k1)
+            _deriv(model, y + 0.5 * dt * k1, p, k2)
+            _deriv(model, y + 0.5 * dt * k2, p, k3)
+            _deriv(model, y + dt * k3, p, k4)
             y = y + dt / 6 * (k1 + 2 * k2 + 2 * k3 + k4)
             t += dt
         out[i] = y
     return out
 
 
-def flow(deriv, p_const, x0, acc, t0, times, h):
-    """States (m, 6) and sensitivities (m, 6, 9) to [x0, acc] at ``times``."""
+def flow(model, p_const, x0, acc, t0, times, h):
+    """States (m, 6) and sensitivities (m, 6, 9) to [x0, acc] at ``times``.
+
+    model: TWOBODY (p_const = [mu]) or CRTBP (p_const = [mu1, mu2, L, omega])."""
     y0 = np.concatenate([x0, np.hstack([np.eye(6), np.zeros((6, 3))]).ravel()])
-    Y = _rk4(deriv, y0, float(t0), np.asarray(times, float), h,
+    Y = _rk4(model, y0, float(t0), np.asarray(times, float), h,
              np.concatenate([p_const, acc]))
     return Y[:, :6], Y[:, 6:].reshape(-1, 6, 9)
 
@@ -156,7 +172,7 @@ def station_states(lat_lon, t):
 
 
 class TwoBodyProblem:
-    """One spacecraft ``sc``: registry [state(6), acc(3), maneuvers..., range biases...].
+    """One spacecraft ``sc``: registry [state(6), acc(3) or none, maneuvers..., range biases...].
 
     rows: per observation the station index and kind (0 range m, 1 range-rate m/s).
     """
@@ -167,7 +183,7 @@ class TwoBodyProblem:
         self.stations = np.asarray(stations_lat_lon, float)
         self.h = h
         self.i_state = registry.slice("state", "sc")
-        self.i_acc = registry.slice("stochastic", "sc")
+        self.i_acc = registry.indices("stochastic", "sc")   # three or none
         self.maneuvers = {}
         for p in registry.parameters:
             if p.kind == "maneuver":
@@ -186,14 +202,18 @@ class TwoBodyProblem:
         n = len(self.registry)
         D = np.zeros((m, 6, n))
         D[:, :, self.i_state] = S[:, :, :6]
-        D[:, :, self.i_acc] = S[:, :, 6:]
+        if self.i_acc.size:
+            D[:, :, self.i_acc] = S[:, :, 6:]
         if dv_idx:
             D[:, :, dv_idx] = S[:, :, 3:6]
         return D
 
+    def _acc(self, x0):
+        return x0[self.i_acc] if self.i_acc.size else np.zeros(3)
+
     def transition(self, t0, t1, x0):
         s, dv_idx = self._start(t0, x0)
-        X, S = flow(_twobody_deriv, np.array([MU_EARTH]), s, x0[self.i_acc], t0, [t1], self.h)
+        X, S = flow(TWOBODY, np.array([MU_EARTH]), s, self._acc(x0), t0, [t1], self.h)
         Phi = np.eye(len(self.registry))
         Phi[self.i_state] = self._registry_sens(S, dv_idx, 1)[0]
         x1 = x0.copy()
@@ -203,7 +223,7 @@ class TwoBodyProblem:
     def predict(self, t0, x0, rows):
         s, dv_idx = self._start(t0, x0)
         t = self.times[rows]
-        X, S = flow(_twobody_deriv, np.array([MU_EARTH]), s, x0[self.i_acc], t0, t, self.h)
+        X, S = flow(TWOBODY, np.array([MU_EARTH]), s, self._acc(x0), t0, t, self.h)
         D = self._registry_sens(S, dv_idx, rows.size)
         st = self.station[rows]
         rs, vs = station_states(self.stations, t)
@@ -230,3 +250,104 @@ def range_and_rate(X, r_other, v_other, kind):
     dz[israte, :3] = du[israte]
     dz[israte, 3:] = u[israte]
     return np.where(israte, rr, rho), dz
+
+
+# ---------------------------------------------------------------- scenario
+
+DSN_LIKE = ((35.43, -116.89), (-35.40, 148.98), (40.43, -4.25))
+
+
+def visible_passes(times, stations_lat_lon, positions, min_el_deg=10.0):
+    """(time index, station) pairs with elevation above ``min_el_deg`` (spherical Earth)."""
+    rs, _ = station_states(stations_lat_lon, times)
+    d = positions[None, :, :] - rs
+    sin_el = np.sum(d * rs, -1) / (np.linalg.norm(d, axis=-1) * R_EARTH)
+    st, it = np.nonzero(sin_el > np.sin(np.radians(min_el_deg)))
+    order = np.lexsort((st, it))
+    return it[order], st[order]
+
+
+def simulate_twobody(x0, acc_batches, batch, maneuvers, times, rtol=1e-12):
+    """Truth states (m, 6) at sorted ``times`` by scipy DOP853 (independent of the RK4).
+
+    acc_batches: (nb, 3) acceleration per batch of ``batch`` s from t = 0;
+    maneuvers: {epoch: dV(3)} applied impulsively.
+    """
+    from scipy.integrate import solve_ivp
+
+    cuts = sorted(set(np.arange(0.0, times[-1], batch)) | set(maneuvers) | {times[-1]})
+    out = np.empty((times.size, 6))
+    x = np.array(x0, float)
+    for a, b in zip(cuts[:-1], cuts[1:]):
+        if a in maneuvers:
+            x[3:] += maneuvers[a]
+        acc = acc_batches[int(a // batch)]
+
+        def rhs(_, y):
+            r = y[:3]
+            return np.concatenate([y[3:], -MU_EARTH * r / np.linalg.norm(r) ** 3 + acc])
+        sel = (times >= a) & (times < b)
+        te = np.append(times[sel], b)
+        y = solve_ivp(rhs, (a, b), x, method="DOP853", rtol=rtol, atol=1e-9, t_eval=te).y
+        out[sel] = y[:, :-1].T
+        x = y[:, -1]
+    out[times == cuts[-1]] = x
+    return out
+
+
+def twobody_case(rng, days=1.0, dt_obs=120.0, batch=8 * 3600.0, sig_acc=5e-9, tau=86400.0,
+                 maneuvers=((10 * 3600.0, (3e-3, -2e-3, 5e-3)),), sig_range=2.0,
+                 sig_rate=1e-4, dx0=(3e4, -2e4, 1e4, 0.3, -0.2, 0.1), stochastic=True):
+    """Simulated two-body arc (orbit radius 20,000 km) tracked by three DSN-like stations.
+
+    Returns (problem, observations, truth) where truth holds the epoch vector in
+    registry order and the per-batch accelerations. A priori as ARTEMIS Table 4.1:
+    100 km, 1 m/s, 5e-9 m/s^2 accelerations, 10 mm/s maneuvers, 5 m range biases.
+    """
+    from .fit import Observations
+
+    r, inc = 2.0e7, np.radians(28.5)
+    v = np.sqrt(MU_EARTH / r)
+    x_nom = np.array([r, 0, 0, 0, v * np.cos(inc), v * np.sin(inc)])
+    reg = ParameterRegistry()
+    reg.add_state("sc", x_nom, 1e5, 1.0)
+    if stochastic:
+        reg.add_stochastic_acceleration("sc", sig_acc, tau, batch, axes=("x", "y", "z"))
+    for j, (ep, _) in enumerate(maneuvers):
+        reg.add_maneuver("sc", f"m{j}", ep, sigma_dv=0.01)
+    for s in range(len(DSN_LIKE)):
+        reg.add(f"bias.range.{s}", "bias", 0.0, 5.0, owner=f"dss{s}")
+    arc = days * 86400.0
+    nb = int(np.ceil(arc / batch)) + 1
+    proc = reg.stochastic_groups()[0][1] if stochastic else None
+    acc = np.zeros((nb, 3))
+    if stochastic:
+        m, q = proc.step()
+        acc[0] = rng.normal(size=3) * sig_acc
+        for j in range(1, nb):
+            acc[j] = m * acc[j - 1] + rng.normal(size=3) * np.sqrt(q)
+    x0 = x_nom + np.asarray(dx0)
+    t_grid = np.arange(0.0, arc, dt_obs)
+    X = simulate_twobody(x0, acc, batch, {ep: np.asarray(dv) for ep, dv in maneuvers}, t_grid)
+    it, st = visible_passes(t_grid, DSN_LIKE, X[:, :3])
+    it, st = np.repeat(it, 2), np.repeat(st, 2)
+    kind = np.tile([0, 1], it.size // 2)
+    t = t_grid[it]
+    rs, vs = station_states(DSN_LIKE, t)
+    mrow = np.arange(t.size)
+    z, _ = range_and_rate(X[it], rs[st, mrow], vs[st, mrow], kind)
+    bias = rng.normal(size=len(DSN_LIKE)) * 5.0
+    z[kind == 0] += bias[st[kind == 0]]
+    sigma = np.where(kind == 0, sig_range, sig_rate)
+    z += rng.normal(size=z.size) * sigma
+    truth_vec = reg.apriori.copy()
+    truth_vec[reg.slice("state", "sc")] = x0
+    if stochastic:
+        truth_vec[reg.slice("stochastic", "sc")] = acc[0]
+    for j, (_, dv) in enumerate(maneuvers):
+        truth_vec[reg.slice("maneuver", f"sc.m{j}")] = dv
+    truth_vec[reg.slice("bias")] = bias
+    problem = TwoBodyProblem(reg, t, st, kind, DSN_LIKE)
+    obs = Observations(t, z, sigma, np.array([f"dss{s}.{'range' if k == 0 else 'rate'}"
+                                              for s, k in zip(st, kind)]))
+    return problem, obs, {"x0": truth_vec, "acc": acc, "states": X, "t_grid": t_grid}
