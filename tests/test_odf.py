@@ -8,9 +8,11 @@ and the GRAIL file names, whose time is the first data time.
 
 from __future__ import annotations
 
+import struct
 from decimal import Decimal
 
 import numpy as np
+import pandas as pd
 import pytest
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
@@ -171,6 +173,11 @@ def test_grail_first_time_matches_file_name_and_outliers_kept(shared_data, name)
     assert t["value"].abs().max() > 1e7  # gross outliers flagged valid are kept
 
 
+def _header(key: int, secondary: int, length: int, packet: int) -> bytes:
+    """An ODF group header record."""
+    return struct.pack(">iIII", key, secondary, length, packet) + bytes(20)
+
+
 def _messenger_bytes(shared_data) -> bytes:
     return (shared_data / MESSENGER).read_bytes()
 
@@ -243,3 +250,24 @@ def test_fuzz_only_parse_errors(odf_head, tmp_path_factory, data):
         except ParseError:
             continue
         assert len(d.table) <= len(buf) // 36
+
+
+@pytest.mark.realdata
+def test_clock_offset_group_and_parquet(shared_data, tmp_path):
+    """A clock offset group (TRK-2-18 table 3-6, as laid out in tudat's OdfClockOffsetBlock) spliced
+    before the EOF group: start/end s + ns, signed offset s + ns, primary and secondary station."""
+    buf = _messenger_bytes(shared_data)
+    n_data = 300
+    head = buf[: 36 * n_data]
+    clock = struct.pack(">IIiiIIIII", 1812103200, 250_000_000, -1, -500_000_000, 14, 63, 0, 1812189600, 0)
+    p = tmp_path / "clock.odf"
+    p.write_bytes(head + _header(2040, 0, 1, n_data) + clock + _header(-1, 0, 0, n_data + 2))
+    d = odf.read(p)
+    assert len(d.table) == n_data - 5 and len(d.report) == 0
+    c = d.meta["clock_offsets"].iloc[0]
+    assert c["offset_s"] == -1.5 and (c["station_primary"], c["station_secondary"]) == ("DSS-14", "DSS-63")
+    assert c["start"] == NS_1950 + np.timedelta64(1812103200_250_000_000, "ns")
+    assert str(c["end"]) == "2007-06-05 10:00:00"
+    d.table.to_parquet(tmp_path / "t.parquet")
+    back = pd.read_parquet(tmp_path / "t.parquet")
+    assert back["epoch"].equals(d.table["epoch"]) and back["value"].equals(d.table["value"])
