@@ -90,6 +90,21 @@ def test_residual_outliers_per_group():
     assert np.flatnonzero(outliers(r, g, k=6.0)).tolist() == [3, 600]
 
 
+def test_residual_outliers_flag_only_used_rows():
+    from odpipe.preprocess.edit import residual_outliers
+
+    rng = np.random.default_rng(7)
+    tab = sine_doppler(n=1000)
+    tab["pass_id"] = np.repeat([0, 1], 500)
+    resid = rng.normal(0, 0.005, 1000)
+    resid[[10, 700]] = 0.1               # 20 sigma
+    tab.loc[20, "flags"] = int(Flag.BLUNDER)
+    resid[20] = 1e3                      # already edited: not a residual outlier, not in the statistics
+    tab.loc[30, "flags"] = int(Flag.RESIDUAL)
+    resid[30] = 0.0                      # flagged by an earlier iteration, now fits: re-tested
+    assert np.flatnonzero(residual_outliers(tab, resid, k=6.0)).tolist() == [10, 700]
+
+
 def test_station_weights_from_postfit_rms():
     rng = np.random.default_rng(6)
     a, b = sine_doppler(n=4000, station_rx="DSS-24"), sine_doppler(n=4000, station_rx="DSS-54")

@@ -9,7 +9,8 @@ Editors look only at columns, so they run on any TrackingTable:
 * blunders: per pass, a gross test on the values and a robust (median/MAD)
   test on the signal detrended by piecewise polynomials between uplink ramp changes;
 * range ambiguity: range outside [0, modulus) (``range_modulus_ru`` column);
-* short passes, outside the arc, analyst windows.
+* short passes, outside the arc, analyst windows;
+* residual outliers during a fit (:func:`residual_outliers`, called by the filter).
 """
 
 from __future__ import annotations
@@ -22,7 +23,7 @@ import pandas as pd
 from odpipe.preprocess import ramp_segments
 from odpipe.preprocess.flags import Flag, set_flag, summary
 from odpipe.preprocess.passes import LINK, assign_passes
-from odpipe.preprocess.robust import gross, robust_detrend
+from odpipe.preprocess.robust import gross, outliers, robust_detrend
 from odpipe.preprocess.timetags import interval_bounds
 
 
@@ -121,6 +122,16 @@ def in_windows(table: pd.DataFrame, windows: list) -> np.ndarray:
                 m &= table[col] == w[col]
         hit |= m.to_numpy()
     return hit
+
+
+def residual_outliers(table: pd.DataFrame, residual: np.ndarray, k: float = 5.0, by: str = "pass_id") -> np.ndarray:
+    """Rows whose fit residual is more than ``k`` robust sigmas from their ``by`` group's median.
+
+    The filter calls this between iterations and ORs :attr:`Flag.RESIDUAL` into
+    ``flags``; only unflagged rows enter the statistics.
+    """
+    use = (table["flags"].to_numpy() & ~int(Flag.RESIDUAL)) == 0
+    return use & outliers(residual, table[by].to_numpy(), k, use)
 
 
 def edit(table: pd.DataFrame, ramps: pd.DataFrame | None = None, config: EditConfig = EditConfig()):
