@@ -11,7 +11,10 @@ zenith troposphere, m; ``CHPART``: line-of-sight ionosphere range delay at
 S-band, m) inside its time window, for a DSN complex (``C10``/``C40``/``C60``)
 or a list of stations, and for ionosphere one spacecraft (``SCID``).
 
-Series (TRK-2-23 "computation specifiers"):
+Series (TRK-2-23 "computation specifiers"; the normalization as in DSN 820-013
+TRK-2-23 Rev. C as implemented by Tudat's ``PowerSeriesReferenceCorrection``
+and ``FourierSeriesReferenceCorrection``; the TRK-2-23 product description
+calls the ION cards "a normalized polynomial for each tracking pass"):
 
 - ``NRMPOW(c0..cn)``: normalized power series, ``sum c_i x**i`` with
   ``x = 2 (t - FROM) / (TO - FROM) - 1`` (the window mapped onto [-1, 1]).
@@ -22,7 +25,8 @@ Series (TRK-2-23 "computation specifiers"):
 ADJUST cards are additive: the value at ``t`` is the sum over all cards whose
 window holds ``t``; a time no card covers evaluates to NaN (never 0), so a
 caller can tell "no calibration" from "zero calibration". Times are UTC
-(``datetime64[ns]``). numpy/stdlib only.
+(``datetime64[ns]``). ``DELETE`` cards and the ``D``-series (DNRMPOW, ...) are
+not supported and raise ParseError (or are reported). numpy/stdlib only.
 """
 
 from __future__ import annotations
@@ -73,7 +77,7 @@ class Card:
 
 
 def complex_of(station) -> str:
-    """DSN complex of a station: 'DSS-14', '14' or 14 -> 'C10'; a complex passes through."""
+    """DSN complex of a station (DSS 10-29 -> C10 Goldstone, 30-49 -> C40 Canberra, 50-69 -> C60 Madrid)."""
     s = str(station).strip().upper()
     if s in ("C10", "C40", "C60"):
         return s
