@@ -63,21 +63,8 @@ def calibrate(table: pd.DataFrame, model: MediaModel, *, target_itrs=None, ramps
     start, end = interval_bounds(epoch, ct, out["tag"].to_numpy())
     rtlt, rtlt_note = _round_trip(out, target_itrs, catalog, epoch)
 
-    samples = []      # (row, leg, instant sign, station, ground time ns, frequency Hz)
     f_up, f_down, f_up_known = _frequencies(out, epoch - np.rint(rtlt * 1e9).astype(np.int64), ramps)
-    for leg, stations, freq, legs_rows in (("down", out["station_rx"], f_down, ground),
-                                           ("up", out["station_tx"], f_up, ground & np.isin(obs, TWO_LEG))):
-        delay_ns = np.rint(rtlt * 1e9).astype(np.int64) if leg == "up" else 0
-        for sign, t in ((1.0, np.where(doppler, end, epoch)), (-1.0, start)):
-            rows = np.flatnonzero(legs_rows & ((sign > 0) | doppler))
-            samples.append(pd.DataFrame({
-                "row": rows, "leg": leg, "sign": sign, "station": stations.to_numpy(dtype=object)[rows],
-                "t": (t - delay_ns)[rows],
-                "f": freq[rows]}))
-    s = pd.concat(samples, ignore_index=True)
-    s["phase"] = doppler[s["row"].to_numpy()]
-    s["pass_id"] = out["pass_id"].to_numpy()[s["row"].to_numpy()]
-    s["spacecraft"] = out["spacecraft"].to_numpy(dtype=object)[s["row"].to_numpy()]
+    s = _samples(out, obs, ground, doppler, epoch, start, end, rtlt, f_up, f_down)
     tropo, iono, lab_t, lab_i = _leg_delays(s, out, model, target_itrs, catalog)
     if order is not None and len(s):
         group = pd.MultiIndex.from_arrays([s["pass_id"], s["leg"], s["station"]]).codes
@@ -96,14 +83,37 @@ def calibrate(table: pd.DataFrame, model: MediaModel, *, target_itrs=None, ramps
     out["media_ru"] = np.where(is_range, out["media_m"].to_numpy() / C_LIGHT * f_ru, np.nan)
     code, texts = pd.factorize("tropo: " + pd.Series(lab_t) + " | iono: " + pd.Series(lab_i))
     texts = np.append(np.asarray(texts, dtype=object), "")
-    first = sign > 0
     for leg, col in (("down", "media_source"), ("up", "media_source_up")):
-        pick = first & (s["leg"].to_numpy() == leg)
+        pick = (sign > 0) & (s["leg"].to_numpy() == leg)
         row_code = np.full(n, len(texts) - 1)
         row_code[rows[pick]] = code[pick]
         out[col] = pd.Categorical(texts[row_code])
     out["media_note"] = _notes(n, rows, code, texts.astype(str), ground, np.isin(obs, TWO_LEG), rtlt_note)
     return out, pass_report(out)
+
+
+def _samples(t, obs, ground, doppler, epoch, start, end, rtlt, f_up, f_down) -> pd.DataFrame:
+    """One sample per (row, leg, instant): the station, its ground time (ns) and the leg frequency.
+
+    Range rows have one instant (the tag); Doppler rows two, the count's end (sign +1) and
+    start (sign -1). Uplink instants are one round-trip light time before reception.
+    """
+    parts = []
+    up_rows = ground & np.isin(obs, TWO_LEG)
+    for leg, stations, freq, leg_rows, shift in (("down", t["station_rx"], f_down, ground, 0),
+                                                 ("up", t["station_tx"], f_up, up_rows,
+                                                  np.rint(rtlt * 1e9).astype(np.int64))):
+        for sign, at in ((1.0, np.where(doppler, end, epoch)), (-1.0, start)):
+            rows = np.flatnonzero(leg_rows & ((sign > 0) | doppler))
+            parts.append(pd.DataFrame({"row": rows, "leg": leg, "sign": sign,
+                                       "station": stations.to_numpy(dtype=object)[rows],
+                                       "t": (at - shift)[rows], "f": freq[rows]}))
+    s = pd.concat(parts, ignore_index=True)
+    r = s["row"].to_numpy()
+    s["phase"] = doppler[r]
+    s["pass_id"] = t["pass_id"].to_numpy()[r]
+    s["spacecraft"] = t["spacecraft"].to_numpy(dtype=object)[r]
+    return s
 
 
 def _frequencies(t: pd.DataFrame, tx_ns, ramps):
