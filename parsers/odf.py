@@ -110,6 +110,13 @@ def station_names(ids: np.ndarray, network: np.ndarray | int = 0) -> np.ndarray:
                        f"DSS-{c % 128:02d}" if c < 128 else f"NET{c // 128}-{c % 128:02d}")
 
 
+def time_ordered(tbl: pd.DataFrame) -> pd.DataFrame:
+    """The table sorted by epoch (stable: file order among equal tags), unchanged when already sorted."""
+    if tbl["epoch"].is_monotonic_increasing:
+        return tbl
+    return tbl.sort_values("epoch", kind="stable").reset_index(drop=True)
+
+
 def transponder_ratio(band_up: np.ndarray, band_down: np.ndarray) -> np.ndarray:
     """Turnaround ratio for each (uplink, downlink) band pair; NaN when unknown or one-way."""
     out = np.full(len(band_up), np.nan)
@@ -163,7 +170,7 @@ def read(path, errors: str = "raise") -> TrackingData:
     summary = np.flatnonzero(body & (group == SUMMARY))
     meta["summary_records"] = [buf[i * RECORD:(i + 1) * RECORD] for i in summary]
     _mark_ramped(tbl, ramps)
-    return TrackingData(table=tbl, ramps=ramps, report=report, meta=meta)
+    return TrackingData(table=time_ordered(tbl), ramps=ramps, report=report, meta=meta)
 
 
 def _label_and_identifier(path, buf, keys, words, is_header) -> dict:

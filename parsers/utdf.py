@@ -43,7 +43,7 @@ import pandas as pd
 
 from parsers import table as tt
 from parsers.errors import ParseError, ParseReport, handle
-from parsers.odf import code_labels
+from parsers.odf import code_labels, time_ordered
 from parsers.table import TrackingData
 
 RECORD = 75
@@ -95,7 +95,7 @@ def read(path, errors: str = "raise") -> TrackingData:
     raw = np.frombuffer(buf, DTYPE, count=n)
     ok = _check(path, raw, errors, report)
     rec = records_frame(raw[ok], np.flatnonzero(ok))
-    table = _table(rec, str(path))
+    table = time_ordered(_table(rec, str(path)))
     meta = {"records": rec, "sic": sorted(set(rec["sic"].tolist())),
             "vid": sorted(set(rec["vid"].tolist()))}
     return TrackingData(table=table, ramps=tt.empty_ramps(), report=report, meta=meta)
