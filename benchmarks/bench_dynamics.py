@@ -1,0 +1,132 @@
+"""Propagation benchmarks: wall time, steps and force evaluations per second.
+
+(a) the peers' case (/work/shared/peers/bench/common.py): 14-day cislunar HEO from
+    2003-06-01, Earth 8x8 (EGM96), Sun and Moon point masses, cannonball SRP with
+    Earth+Moon shadow; max step 45 min and 1 d, with and without the 6x6 STM.
+(b) 14-day Earth-Moon L2 libration orbit: Earth 16x16 (EGM96), Moon 16x16
+    (LP165P), Sun, Venus, Mars, Jupiter, Saturn, SRP, STM.
+(c) 1 day of a 55-km lunar orbit: Moon 200x200 (LP lpe200) with partials to degree
+    50, Earth and Sun point masses, STM.
+
+Run: .venv/bin/python benchmarks/bench_dynamics.py  (compile time is reported apart).
+"""
+
+from __future__ import annotations
+
+import os
+import time
+from pathlib import Path
+
+import numpy as np
+
+from odpipe.dynamics.crtbp import EarthMoonUnits, propagate_crtbp
+from odpipe.dynamics.forces import (ForceModel, PointMasses, SolarRadiationPressure,
+                                    SphericalHarmonics)
+from odpipe.dynamics.propagator import propagate
+from odpipe.environment.ephemeris import Ephemeris
+from odpipe.environment.gravity import read_gravity
+from odpipe.time import utc_to_tdb
+
+DATA = Path(os.environ.get("ODPIPE_SHARED_DATA", Path(__file__).resolve().parents[2] / "shared" / "data"))
+PEER_FINAL_KM = {  # final positions printed by the peers' runs (bench/results/*.json)
+    "nyx 2.6.0 RK89": np.array([-335876.45645546576, 25752.521929658575, -156235.41356561327]),
+    "Orekit 13.1.9 DP853": np.array([-335876.3442637621, 25752.24517815597, -156235.37508346396]),
+}
+
+
+def timed(fn, repeat=3):
+    best = None
+    for _ in range(repeat):
+        t = time.perf_counter()
+        out = fn()
+        dt = time.perf_counter() - t
+        best = dt if best is None else min(best, dt)
+    return best, out
+
+
+def report(label, seconds, traj):
+    print(f"{label:48s} {seconds:8.3f} s  steps {traj.n_steps:6d}  evals {traj.n_eval:7d}  "
+          f"{traj.n_eval / seconds:10.0f} evals/s")
+
+
+def case_peers(eph):
+    t0 = float(utc_to_tdb(np.datetime64("2003-06-01T00:00:00"))[()])
+    t1 = t0 + 14 * 86400.0
+    x0 = np.array([6252.878075666748, -360.9143112901398, 2842.206999982947,
+                   -0.559937727219993, 10.347539903919273, 2.5458376452827824]) * 1e3
+    egm = read_gravity(DATA / "gravity/gmat/EGM96.cof")
+    fm = ForceModel("earth", [SphericalHarmonics("earth", egm, 8), PointMasses(["moon", "sun"]),
+                              SolarRadiationPressure(cr_area=1.3 * 5.0)], mass=500.0, ephemeris=eph)
+    print("(a) peers' case: 14-day HEO, Earth 8x8, Sun+Moon, cannonball SRP, rtol 1e-12")
+    for max_step, tag in ((2700.0, "45min"), (86400.0, "1d")):
+        for stm in (False, True):
+            sec, traj = timed(lambda: propagate(x0, t0, t1, fm, with_stm=stm, params=[] if stm else None,
+                                                rtol=1e-12, atol=1e-6, max_step=max_step))
+            report(f"  max step {tag}, {'6x6 STM' if stm else 'state only'}", sec, traj)
+        final = traj.state(t1)[0][:3] / 1e3
+        for peer, ref in PEER_FINAL_KM.items():
+            print(f"    final position vs {peer}: {np.linalg.norm(final - ref) * 1e3:8.1f} m")
+
+
+def case_libration(eph):
+    t0 = float(utc_to_tdb(np.datetime64("2012-04-01T00:00:00"))[()])
+    units = EarthMoonUnits(gm1=eph.gm("earth"), gm2=eph.gm("moon"))
+    # L2 halo-type orbit of period 3.4154 (14.8 d), differentially corrected in the CRTBP with its STM
+    halo = np.array([1.1808881, 0.0, -0.00327775, 0.0, -0.15591859, 0.0])
+    # CRTBP rotating state -> ICRF Earth-centred state with the instantaneous Earth-Moon frame
+    moon = eph.state("moon", "earth", np.array([t0]))[0]
+    r_m, v_m = moon[:3], moon[3:]
+    x_hat = r_m / np.linalg.norm(r_m)
+    z_hat = np.cross(r_m, v_m) / np.linalg.norm(np.cross(r_m, v_m))
+    rot = np.column_stack([x_hat, np.cross(z_hat, x_hat), z_hat])
+    dist = np.linalg.norm(r_m)
+    omega = np.linalg.norm(np.cross(r_m, v_m)) / dist**2
+    r_rel = (halo[:3] + [units.mu, 0, 0]) * dist
+    r_in = rot @ r_rel
+    v_in = rot @ (halo[3:] * dist * omega) + np.cross(omega * z_hat, r_in)
+    x0 = np.r_[r_in, v_in]
+    egm = read_gravity(DATA / "gravity/gmat/EGM96.cof")
+    lp = read_gravity(DATA / "gravity/gmat/LP165P.cof")
+    fm = ForceModel("earth", [SphericalHarmonics("earth", egm, 16), SphericalHarmonics("moon", lp, 16),
+                              PointMasses(["moon", "sun", "venus", "mars", "jupiter", "saturn"]),
+                              SolarRadiationPressure(cr_area=1.3 * 5.0)], mass=500.0, ephemeris=eph)
+    print("(b) 14-day Earth-Moon L2 libration orbit, Earth 16x16, Moon 16x16, Sun+planets, SRP")
+    for stm in (False, True):
+        sec, traj = timed(lambda: propagate(x0, t0, t0 + 14 * 86400.0, fm, with_stm=stm,
+                                            rtol=1e-12, atol=1e-6, max_step=2700.0))
+        report(f"  {'6x6 STM + SRP-scale sensitivity' if stm else 'state only'}", sec, traj)
+    crtbp = propagate_crtbp(halo, 0.0, 14 * 86400.0 / units.time, units.mu, with_stm=False)
+    print(f"    CRTBP reference: {crtbp.n_steps} steps; ephemeris-model distance from the Moon after 14 d "
+          f"{np.linalg.norm(traj.state(t0 + 14 * 86400.0)[0][:3] - eph.position('moon', 'earth', np.array([t0 + 14 * 86400.0]))[0]) / 1e3:.0f} km")
+
+
+def case_low_lunar(eph):
+    t0 = float(utc_to_tdb(np.datetime64("2012-04-08T00:00:00"))[()])
+    lpe = read_gravity(DATA / "gravity/tudat/lpe200.txt")
+    r = lpe.radius + 55e3
+    v = np.sqrt(lpe.gm / r)
+    inc = np.radians(89.0)
+    x0 = np.array([r, 0.0, 0.0, 0.0, v * np.cos(inc), v * np.sin(inc)])
+    fm = ForceModel("moon", [SphericalHarmonics("moon", lpe, 200, partial_degree=50),
+                             PointMasses(["earth", "sun"])], mass=300.0, ephemeris=eph)
+    print("(c) 1 day, 55-km polar lunar orbit, Moon 200x200 (partials 50x50), Earth+Sun, STM")
+    sec, traj = timed(lambda: propagate(x0, t0, t0 + 86400.0, fm, with_stm=True, rtol=1e-11, atol=1e-6),
+                      repeat=1)
+    report("  6x6 STM", sec, traj)
+
+
+def main():
+    eph = Ephemeris.open("de440")
+    t = time.perf_counter()
+    import odpipe.dynamics.rhs  # noqa: F401  (numba cache load or compile)
+    fm = ForceModel("earth", central_gm=3.986e14)
+    propagate(np.array([7e6, 0, 0, 0, 7.5e3, 0]), 0.0, 60.0, fm)
+    propagate(np.array([7e6, 0, 0, 0, 7.5e3, 0]), 0.0, 60.0, fm, with_stm=False)
+    print(f"numba load/compile: {time.perf_counter() - t:.1f} s")
+    case_peers(eph)
+    case_libration(eph)
+    case_low_lunar(eph)
+
+
+if __name__ == "__main__":
+    main()
