@@ -20,6 +20,7 @@ import numpy as np
 from odpipe.environment.eop import EOPValues, eop_at
 from odpipe.environment.interpolation import on_uniform_grid
 from odpipe.frames.epochs import utc_and_tt
+from odpipe.frames.rotations import frame_rotation
 from odpipe.time.leap_seconds import NS_PER_DAY
 from odpipe.time.scales import J2000_JD, J2000_NS
 
@@ -96,17 +97,6 @@ def itrs_to_gcrs(t, eop: EOPValues | None = None) -> np.ndarray:
     return np.swapaxes(gcrs_to_itrs(t, eop), -1, -2)
 
 
-def _rz(angle: np.ndarray) -> np.ndarray:
-    c, s = np.cos(angle), np.sin(angle)
-    m = np.zeros(np.shape(angle) + (3, 3))
-    m[..., 0, 0] = c
-    m[..., 0, 1] = s
-    m[..., 1, 0] = -s
-    m[..., 1, 1] = c
-    m[..., 2, 2] = 1.0
-    return m
-
-
 def _mv(m: np.ndarray, v: np.ndarray) -> np.ndarray:
     return np.einsum("...ij,...j->...i", m, v)
 
@@ -129,7 +119,7 @@ def itrs_to_gcrs_state(t, r_itrs, v_itrs=None, eop: EOPValues | None = None):
     v_tirs = np.zeros_like(r_tirs) if v_itrs is None else _mtv(rot.rpom, np.asarray(v_itrs, dtype=float))
     w = np.asarray(rot.omega)[..., None]
     v_tirs = v_tirs + w * np.stack([-r_tirs[..., 1], r_tirs[..., 0], np.zeros_like(r_tirs[..., 0])], axis=-1)
-    rz = _rz(rot.era)
+    rz = frame_rotation(3, rot.era)
     r_cirs = _mtv(rz, r_tirs)
     return _mtv(rot.rc2i, r_cirs), _mtv(rot.rc2i, _mtv(rz, v_tirs)) + _mtv(rot.rc2i_rate, r_cirs)
 
@@ -137,7 +127,7 @@ def itrs_to_gcrs_state(t, r_itrs, v_itrs=None, eop: EOPValues | None = None):
 def gcrs_to_itrs_state(t, r_gcrs, v_gcrs=None, eop: EOPValues | None = None):
     """ITRS position (m) and velocity (m/s) from GCRS position/velocity at epochs ``t``."""
     rot = earth_rotation(t, eop, with_rate=True)
-    rz = _rz(rot.era)
+    rz = frame_rotation(3, rot.era)
     r = np.asarray(r_gcrs, dtype=float)
     v_cirs = _mv(rot.rc2i_rate, r) + (0.0 if v_gcrs is None else _mv(rot.rc2i, np.asarray(v_gcrs, dtype=float)))
     r_tirs = _mv(rz, _mv(rot.rc2i, r))

@@ -23,26 +23,12 @@ from pathlib import Path
 import numpy as np
 
 from odpipe.environment.ephemeris import jd_split
+from odpipe.frames.rotations import frame_rotation
 
 ARCSEC = np.pi / (180.0 * 3600.0)
 _DEG = np.pi / 180.0
 # MOON_ME_DE421 relative to MOON_PA_DE421 (NAIF moon_080317.tf, TKFRAME_31007), arcsec, axes (3, 2, 1)
 ME_DE421_ANGLES_ARCSEC = (67.92, 78.56, 0.30)
-
-
-def _rot(axis: int, angle) -> np.ndarray:
-    """Frame rotation matrices about ``axis`` (1, 2, 3) by ``angle`` rad: (..., 3, 3)."""
-    a = np.asarray(angle, dtype=float)
-    c, s = np.cos(a), np.sin(a)
-    m = np.zeros(a.shape + (3, 3))
-    i, j = {1: (1, 2), 2: (2, 0), 3: (0, 1)}[axis]
-    k = axis - 1
-    m[..., k, k] = 1.0
-    m[..., i, i] = c
-    m[..., j, j] = c
-    m[..., i, j] = s
-    m[..., j, i] = -s
-    return m
 
 
 @lru_cache(maxsize=4)
@@ -69,14 +55,14 @@ def moon_pa_to_icrf(t_tdb, kernel: str | Path | None = None) -> np.ndarray:
         phi, theta, psi = np.reshape(_libration_source(None if kernel is None else str(kernel))(jd1, jd2), (3, -1))
     except Exception as err:  # jplephem raises its own DateError/ValueError types
         raise ValueError(f"lunar librations unavailable for TDB {t.min():.1f}..{t.max():.1f} s past J2000: {err}") from err
-    icrf_to_pa = _rot(3, psi) @ _rot(1, theta) @ _rot(3, phi)
+    icrf_to_pa = frame_rotation(3, psi) @ frame_rotation(1, theta) @ frame_rotation(3, phi)
     return np.swapaxes(icrf_to_pa, -1, -2).reshape(t.shape + (3, 3))
 
 
 def moon_me_to_pa() -> np.ndarray:
     """Constant rotation Moon ME → PA (DE421 realization, NAIF moon_080317.tf)."""
     a3, a2, a1 = (x * ARCSEC for x in ME_DE421_ANGLES_ARCSEC)
-    return _rot(3, a3) @ _rot(2, a2) @ _rot(1, a1)  # SPICE TKFRAME convention: frame -> RELATIVE
+    return frame_rotation(3, a3) @ frame_rotation(2, a2) @ frame_rotation(1, a1)  # SPICE TKFRAME convention: frame -> RELATIVE
 
 
 def moon_me_to_icrf(t_tdb, kernel: str | Path | None = None) -> np.ndarray:
@@ -108,5 +94,5 @@ def moon_iau_to_icrf(t_tdb) -> np.ndarray:
     ra = _RA[0] + _RA[1] * cent + np.sin(e) @ _RA[2]
     dec = _DEC[0] + _DEC[1] * cent + np.cos(e) @ _DEC[2]
     w = _PM[0] + _PM[1] * d + _PM[2] * d**2 + np.sin(e) @ _PM[3]
-    icrf_to_body = _rot(3, w * _DEG) @ _rot(1, (90.0 - dec) * _DEG) @ _rot(3, (90.0 + ra) * _DEG)
+    icrf_to_body = frame_rotation(3, w * _DEG) @ frame_rotation(1, (90.0 - dec) * _DEG) @ frame_rotation(3, (90.0 + ra) * _DEG)
     return np.swapaxes(icrf_to_body, -1, -2)
