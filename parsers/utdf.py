@@ -140,7 +140,10 @@ def encode(records: pd.DataFrame) -> bytes:
             out[name.split("_")[0] + "_hi"] = col >> 16
             out[name.split("_")[0] + "_lo"] = col & 0xFFFF
         elif name == "router":
-            out[name] = np.char.encode(col.astype(str), "latin-1")
+            text = col.astype(str)
+            if len(text) and np.char.str_len(text).max() > 2:
+                raise ValueError("UTDF field router longer than 2 characters")
+            out[name] = np.char.encode(text, "latin-1")
         elif DTYPE[name].kind == "S":
             out[name] = col
         else:
@@ -167,7 +170,7 @@ def write(path, records: pd.DataFrame) -> None:
 def epochs(rec: pd.DataFrame) -> np.ndarray:
     """datetime64[ns] UTC time tags of records."""
     yy = rec["year"].to_numpy().astype(np.int64)
-    year = np.where(yy >= 100, 1900 + yy, np.where(yy >= 70, 1900 + yy, 2000 + yy))
+    year = np.where(yy >= 70, 1900 + yy, 2000 + yy)  # 70-99 and years since 1900 (>= 100) alike
     jan1 = (year - 1970).astype("datetime64[Y]").astype("datetime64[ns]")
     ns = rec["seconds_of_year"].to_numpy().astype(np.int64) * 1_000_000_000 \
         + rec["microseconds"].to_numpy().astype(np.int64) * 1000
