@@ -67,3 +67,17 @@ def test_exponent_change_inside_a_map(tmp_path, shared_data):
     m = read_ionex(p)
     assert m.tec[0, 0, 0, 0] == pytest.approx(891.7)      # 8917 x 10^-1 instead of 10^-2
     assert m.tec[1, 0, 0, 0] == pytest.approx(read_ionex(shared_data / "ionex" / "jammed-fields.14i").tec[1, 0, 0, 0])
+
+
+def test_rms_maps_read_beside_tec(tmp_path, shared_data):
+    # jammed-fields.14i carries TEC maps only; its TEC blocks relabelled as RMS maps must come back as rms
+    lines = (shared_data / "ionex" / "jammed-fields.14i").read_text().splitlines()
+    k = next(i for i, s in enumerate(lines) if "END OF HEADER" in s) + 1
+    header, body = lines[:k], [s for s in lines[k:] if "END OF FILE" not in s]
+    rms = [s.replace("START OF TEC MAP", "START OF RMS MAP").replace("END OF TEC MAP", "END OF RMS MAP")
+           for s in body]
+    p = tmp_path / "rms.14i"
+    p.write_text("\n".join(header + body + rms + [" " * 60 + "END OF FILE"]) + "\n")
+    m = read_ionex(p)
+    assert m.rms is not None and m.rms.shape == m.tec.shape
+    np.testing.assert_array_equal(m.rms, m.tec)
