@@ -21,7 +21,10 @@ from degrees to rad. The reference frequency (``reference_hz``) is, per the
 spec, the spacecraft transponder frequency for one-way data, the receiver
 frequency for ramped two/three-way data and the transmitter frequency
 otherwise; ``uplink_hz`` repeats it except for ramped rows (NaN there): rows
-whose transmitting station has ramp records in the file.
+whose transmitting station has ramp records in the file. The one-way
+reference is given at S-band scale: the downlink is reference * 240/240 (S),
+* 880/240 (X) or * 3344/240 (Ka) (GRAIL: 2280.6 MHz S, 2305.036363636 MHz
+-> 8451.8 MHz X; MESSENGER: 2299.812417 MHz -> 8432.645529 MHz X).
 
 Extra columns after the contract: ``odf_data_type``, ``validity`` (0 good,
 1 bad), ``network_id``, ``band_exciter``, ``reference_hz``,
