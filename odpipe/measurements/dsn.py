@@ -11,7 +11,8 @@ Conventions, all tested:
   ``R = F * integral(f_T dt, t1, t3) mod M`` with F the range-unit factor of the
   uplink band (:mod:`.bands`), f_T the transmitter's uplink (ramped or
   constant), t1 = t3 - rho - delay (station plus transponder delay, s).
-  In metres: ``R = c (rho + delay) / 2``. PN range uses the same range unit.
+  In metres: ``R = c (rho + delay) / 2``; in seconds (ODF type 41): ``rho + delay``.
+  PN range uses the same range unit.
 * **Two/three-way Doppler** (Hz), count interval [t3s, t3e] of Tc s, turnaround M2:
   ``F = (M2/Tc) [integral(f_R, t3s, t3e) - integral(f_T, t1s, t1e)]``,
   with f_R the receiver's reference (the same ramp as f_T unless a receiver
@@ -46,7 +47,7 @@ def _events(sols_and_gains) -> list[EventPartial]:
 
 
 def dsn_range(sol, uplink, station_tx, t3_utc, ru_factor, unit: str = "RU", delay_s=0.0, modulus=np.nan) -> Computed:
-    """Two/three-way range (RU or m) of rows with reception epochs ``t3_utc`` (datetime64[ns]).
+    """Two/three-way range (RU, m or s) of rows with reception epochs ``t3_utc`` (datetime64[ns]).
 
     ``uplink``: ramp store or :class:`ConstantUplink`; ``ru_factor``: F per row;
     ``modulus``: M in RU per row (NaN: no wrap). Parameters: 'bias' (unit) and
@@ -60,11 +61,11 @@ def dsn_range(sol, uplink, station_tx, t3_utc, ru_factor, unit: str = "RU", dela
         value = np.asarray(ru_factor, dtype=float) * uplink.phase(station_tx, t3_utc, t3_utc, -rho, 0.0)
         m = np.broadcast_to(np.asarray(modulus, dtype=float), value.shape)
         value = np.where(np.isfinite(m), np.mod(value, np.where(np.isfinite(m), m, 1.0)), value)
-    elif unit == "m":
-        gain = np.full(rho.shape, C_LIGHT / 2)
+    elif unit in ("m", "s"):
+        gain = np.full(rho.shape, C_LIGHT / 2 if unit == "m" else 1.0)
         value = gain * rho
     else:
-        raise ValueError(f"range unit must be 'RU' or 'm', not {unit!r}")
+        raise ValueError(f"range unit must be 'RU', 'm' or 's', not {unit!r}")
     return Computed(value, unit, _events([(sol, gain)]), {"bias": np.ones_like(value), "delay": gain},
                     to_los=C_LIGHT / (2 * gain))
 

@@ -4,7 +4,9 @@ For a spacecraft flying a trajectory with ``stm(t) -> (N,6,6)`` (d x(t) / d x(t0
 and ``sensitivity(t) -> (N,6,p)`` (d x(t) / d p), the partial of an observable
 with respect to the arc's epoch state is the sum over the spacecraft's events
 of ``[d_pos, d_vel] @ stm(t_event)`` (likewise for p). For a station, the
-partial with respect to its ITRS position is ``d_pos @ R_itrs_to_icrf(t_event)``.
+partial with respect to its ITRS position is ``d_pos @ R_itrs_to_icrf(t_event)``,
+plus ``d_vel @ R_itrs_to_icrf @ [omega x]`` where a velocity partial exists (the
+antenna's velocity is the Earth's rotation of its position).
 """
 
 from __future__ import annotations
@@ -12,6 +14,9 @@ from __future__ import annotations
 import numpy as np
 
 from .computed import Computed
+from .nodes import EARTH_ROTATION_RATE
+
+_OMEGA_CROSS = np.array([[0.0, -EARTH_ROTATION_RATE, 0.0], [EARTH_ROTATION_RATE, 0.0, 0.0], [0.0, 0.0, 0.0]])
 
 
 def event_gradient(computed: Computed, role: str) -> list[tuple[np.ndarray, np.ndarray]]:
@@ -44,5 +49,8 @@ def station_partials(computed: Computed, role: str, station_node) -> np.ndarray:
     total = np.zeros((computed.value.size, 3))
     for ev in computed.events:
         if ev.role == role:
-            total += np.einsum("ni,nij->nj", ev.d_pos, station_node.itrs_to_frame(ev.t))
+            rot = station_node.itrs_to_frame(ev.t)
+            total += np.einsum("ni,nij->nj", ev.d_pos, rot)
+            if ev.d_vel is not None:
+                total += np.einsum("ni,nij,jk->nk", ev.d_vel, rot, _OMEGA_CROSS)
     return total

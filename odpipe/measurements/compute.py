@@ -1,0 +1,274 @@
+"""One entry point: computed values and partials for the rows of a TrackingTable.
+
+``compute(rows, trajectories, setup) -> Evaluation``
+
+Rows are grouped by (observable, unit, stations, spacecraft, tag) and each
+group is evaluated vectorized. Supported observables and their row fields:
+
+=================  ==========================================================================
+range              two/three-way range, ``unit`` 'RU', 'm' or 's', tagged at reception; band_up
+                   gives the range-unit factor; uplink from the ramp store when ``ramped``,
+                   else ``uplink_hz``; optional columns ``range_modulus`` (RU), ``delay_s``.
+doppler_2way/3way  count-averaged Doppler (Hz), interval from ``epoch``/``tag``/``count_time``;
+                   M2 = ``transponder_ratio`` or the band pair's; the receiver's own ramp is the
+                   reference for ramped three-way rows when the store has that station.
+doppler_1way       f_ref = ``uplink_hz``; the spacecraft oscillator from ``setup.oscillators``.
+angle_az/el/x/y    antenna angles at reception (rad).
+range_rate         instantaneous station-spacecraft range-rate at reception (m/s), for studies.
+sst_range          crosslink two-way range (m); ``spacecraft`` = sc1 (transmits and receives,
+sst_doppler        time tag at its reception), extra column ``spacecraft_2`` = sc2;
+                   sst_doppler is the round-trip path change over ``count_time`` (m/s).
+dowr_sum/diff      dual one-way ranging combinations (m) of ``spacecraft`` (sc1) and
+                   ``spacecraft_2`` (sc2), both received at ``epoch``; clocks from ``setup.clocks``.
+=================  ==========================================================================
+
+Media: a ``media_m`` column (odpipe.media: round-trip path delay for range,
+its change over the count interval for Doppler) enters the model as
+``setup.media_scale * media`` in the observable's unit when
+``setup.media_in_model`` (then the observed values must not be corrected
+too); its partial is the group 'media_scale' either way.
+
+Partial groups in :attr:`Evaluation.partials` (N rows x k columns, zero for
+rows that do not involve the group):
+``state:<sc>`` (6, d/d epoch state of the trajectory), ``dynamic:<sc>``
+(p, ``traj.param_names``), ``station:<name>`` (3, ITRS m), ``bias`` (1, unit of
+the row), ``delay`` (1, per s of range delay), ``media_scale`` (1),
+``oscillator:<sc>`` (2: Hz bias, Hz/s drift), ``clock:<sc>`` (3: c*a0, c*a1, c*a2).
+Rows that cannot be computed get NaN and a reason in :attr:`Evaluation.status`.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from typing import Callable, Mapping
+
+import numpy as np
+import pandas as pd
+
+from odpipe.preprocess.timetags import interval_bounds
+
+from . import angles, crosslink, dsn, instantaneous
+from .bands import C_LIGHT, range_unit_factor, turnaround_ratio
+from .computed import Computed, ConstantUplink
+from .lighttime import anchor_from_utc, solve_path
+from .nodes import SpacecraftNode, StationNode
+from .partials import dynamic_partials, epoch_state_partials, station_partials
+
+_ANGLES = {"angle_az": "azimuth", "angle_el": "elevation", "angle_x": "x", "angle_y": "y"}
+
+
+@dataclass
+class MeasurementSetup:
+    """Everything the models need besides rows and trajectories; built once per run.
+
+    oscillators: spacecraft -> (f_nominal Hz, bias Hz, drift Hz/s, t_ref TDB s) for one-way Doppler.
+    clocks: spacecraft -> :class:`.crosslink.ClockModel` for dual one-way ranging.
+    """
+
+    ephemeris: object
+    stations: object
+    ramps: object = None
+    gcrs_to_itrs: Callable | None = None
+    origin: str = "ssb"
+    shapiro_bodies: tuple = ("sun", "earth")
+    media_scale: float = 1.0
+    media_in_model: bool = True
+    oscillators: dict = field(default_factory=dict)
+    clocks: dict = field(default_factory=dict)
+
+    @classmethod
+    def default(cls, **kw) -> "MeasurementSetup":
+        """DE440, the default station catalog and the IAU 2006/2000A Earth orientation with EOP."""
+        from odpipe.environment.ephemeris import Ephemeris
+        from odpipe.environment.stations import StationCatalog
+        from odpipe.frames.earth import gcrs_to_itrs
+
+        return cls(Ephemeris.open("de440"), StationCatalog.default(), gcrs_to_itrs=gcrs_to_itrs, **kw)
+
+    def station(self, name: str) -> StationNode:
+        st = self.stations[name]
+        return StationNode(st.position_itrs, self.gcrs_to_itrs, self.ephemeris, self.origin, name)
+
+    def spacecraft(self, traj, name: str) -> SpacecraftNode:
+        return SpacecraftNode(traj, self.ephemeris, self.origin, name)
+
+
+@dataclass
+class Evaluation:
+    """Computed values (row units), LOS scale (m or m/s per unit), reasons, partial groups, column names."""
+
+    value: np.ndarray
+    to_los: np.ndarray
+    status: np.ndarray
+    partials: dict[str, np.ndarray]
+    names: dict[str, list[str]]
+
+
+class _Unsupported(Exception):
+    pass
+
+
+def compute(rows: pd.DataFrame, trajectories: Mapping, setup: MeasurementSetup) -> Evaluation:
+    """Computed observables and partials of ``rows`` (a TrackingTable slice) given trajectories by spacecraft id."""
+    n = len(rows)
+    out = Evaluation(np.full(n, np.nan), np.full(n, np.nan), np.full(n, "", dtype=object), {}, {})
+    df = rows.reset_index(drop=True)
+    sc2 = df["spacecraft_2"] if "spacecraft_2" in df.columns else pd.Series([""] * n)
+    keys = [df["observable"], df["unit"], df["station_tx"], df["station_rx"], df["spacecraft"].astype(str),
+            sc2.astype(str), df["tag"]]
+    for key, idx in pd.DataFrame(dict(enumerate(keys))).groupby(list(range(7)), sort=False).indices.items():
+        g = df.iloc[idx]
+        try:
+            comp, roles = _evaluate(key, g, trajectories, setup)
+        except _Unsupported as exc:
+            out.status[idx] = str(exc)
+            continue
+        _store(out, idx, n, comp, roles, g, setup)
+    return out
+
+
+def _evaluate(key, g, trajectories, setup):
+    obs, unit, tx, rx, sc, sc2, tag = key
+    tx = tx or rx
+    traj = _trajectory(trajectories, sc)
+    epoch = g["epoch"].to_numpy(dtype="datetime64[ns]")
+    bodies = dict(shapiro_bodies=setup.shapiro_bodies, ephemeris=setup.ephemeris, origin=setup.origin)
+
+    def solve(nodes, utc, anchor="receive"):
+        t, c = anchor_from_utc(utc)
+        return solve_path(nodes, t, anchor=anchor, t_corr=c, **bodies)
+
+    def interval():
+        s, e = interval_bounds(epoch.astype(np.int64), g["count_time"].to_numpy(float), g["tag"].to_numpy(object))
+        return s.astype("datetime64[ns]"), e.astype("datetime64[ns]")
+
+    if obs == "range" or obs.startswith("doppler_") and obs != "doppler_1way":
+        if obs == "range" and tag not in ("receive", "interval_end"):
+            raise _Unsupported(f"range tagged {tag!r}: only reception tags are modelled")
+        st_tx, st_rx = setup.station(tx), setup.station(rx)
+        nodes = [st_tx, setup.spacecraft(traj, sc), st_rx]
+        up = _uplink(g, tx, setup)
+        roles = {"station_tx": ("station", tx, st_tx), "station_rx": ("station", rx, st_rx), "spacecraft": ("sc", sc, traj)}
+        if obs == "range":
+            ru = range_unit_factor(g["band_up"].to_numpy(object))
+            modulus = g["range_modulus"].to_numpy(float) if "range_modulus" in g.columns else np.nan
+            delay = np.nan_to_num(g["delay_s"].to_numpy(float)) if "delay_s" in g.columns else 0.0
+            if unit not in ("RU", "m", "s"):
+                raise _Unsupported(f"range in unit {unit!r}: only RU, m and s are modelled")
+            return dsn.dsn_range(solve(nodes, epoch), up, tx, epoch, ru, unit, delay, modulus), roles
+        m2 = g["transponder_ratio"].to_numpy(float)
+        m2 = np.where(np.isfinite(m2), m2, turnaround_ratio(g["band_up"].to_numpy(object), g["band_down"].to_numpy(object)))
+        s, e = interval()
+        ref = None
+        if obs == "doppler_3way" and setup.ramps is not None and rx in getattr(setup.ramps, "stations", []) \
+                and g["ramped"].to_numpy(bool).all():
+            ref = setup.ramps
+        return dsn.dsn_doppler(solve(nodes, s), solve(nodes, e), up, tx, s, e, m2, ref, rx), roles
+    if obs == "doppler_1way":
+        st_rx = setup.station(rx)
+        nodes = [setup.spacecraft(traj, sc), st_rx]
+        f_ref = g["uplink_hz"].to_numpy(float)
+        f0, bias, drift, t_ref = setup.oscillators.get(sc, (f_ref, 0.0, 0.0, 0.0))
+        s, e = interval()
+        comp = dsn.one_way_doppler(solve(nodes, s), solve(nodes, e), f_ref, f0, g["count_time"].to_numpy(float),
+                                   bias, drift, t_ref)
+        comp.params[f"oscillator:{sc}"] = np.stack([comp.params.pop("freq_bias"), comp.params.pop("freq_drift")], 1)
+        return comp, {"station_rx": ("station", rx, st_rx), "spacecraft": ("sc", sc, traj)}
+    if obs in _ANGLES:
+        st_rx = setup.station(rx)
+        sol = solve([setup.spacecraft(traj, sc), st_rx], epoch)
+        return angles.antenna_angle(sol, st_rx, _ANGLES[obs]), {"station_rx": ("station", rx, st_rx),
+                                                                "spacecraft": ("sc", sc, traj)}
+    if obs == "range_rate":
+        st_rx = setup.station(rx)
+        t, c = anchor_from_utc(epoch)
+        comp = instantaneous.instantaneous_range_rate(st_rx.state(t), setup.spacecraft(traj, sc).state(t), t,
+                                                      ("station_rx", "spacecraft"))
+        return comp, {"station_rx": ("station", rx, st_rx), "spacecraft": ("sc", sc, traj)}
+    if obs in ("sst_range", "sst_doppler", "dowr_sum", "dowr_diff"):
+        traj2 = _trajectory(trajectories, sc2)
+        n1, n2 = setup.spacecraft(traj, sc), setup.spacecraft(traj2, sc2)
+        roles = {"sc1": ("sc", sc, traj), "sc2": ("sc", sc2, traj2)}
+        if obs == "sst_range":
+            return crosslink.two_way_range(solve([n1, n2, n1], epoch)), roles
+        if obs == "sst_doppler":
+            s, e = interval()
+            return crosslink.two_way_doppler(solve([n1, n2, n1], s), solve([n1, n2, n1], e),
+                                             g["count_time"].to_numpy(float)), roles
+        c1, c2 = setup.clocks.get(sc, crosslink.ClockModel()), setup.clocks.get(sc2, crosslink.ClockModel())
+        total, diff = crosslink.dual_one_way(solve([n2, n1], epoch), solve([n1, n2], epoch), c1, c2)
+        comp = total if obs == "dowr_sum" else diff
+        for who in ("sc1", "sc2"):
+            name = sc if who == "sc1" else sc2
+            comp.params[f"clock:{name}"] = np.stack([comp.params.pop(f"clock_{who}_{k}") for k in ("a0", "a1", "a2")], 1)
+        return comp, roles
+    raise _Unsupported(f"observable {obs!r} has no model")
+
+
+def _trajectory(trajectories, sc):
+    if sc not in trajectories:
+        raise _Unsupported(f"no trajectory for spacecraft {sc!r}")
+    return trajectories[sc]
+
+
+def _uplink(g, station, setup):
+    ramped = g["ramped"].to_numpy(bool)
+    if ramped.any():
+        if setup.ramps is None or station not in setup.ramps.stations:
+            raise _Unsupported(f"ramped rows but no ramps for {station!r}")
+        if not ramped.all():
+            raise _Unsupported("a group mixes ramped and constant uplink rows")
+        return setup.ramps
+    return ConstantUplink(g["uplink_hz"].to_numpy(float))
+
+
+def _media(comp: Computed, g) -> np.ndarray | None:
+    """The media column in the observable's unit, or None."""
+    if "media_m" not in g.columns:
+        return None
+    m = np.nan_to_num(g["media_m"].to_numpy(float))
+    obs = g["observable"].iloc[0]
+    if obs == "range":
+        return m / 2 / comp.to_los
+    if obs in ("doppler_2way", "doppler_3way"):
+        return m / (2 * g["count_time"].to_numpy(float)) / comp.to_los
+    if obs == "doppler_1way":
+        return m / g["count_time"].to_numpy(float) / comp.to_los
+    return None
+
+
+def _store(out: Evaluation, idx, n, comp: Computed, roles, g, setup):
+    value = np.asarray(comp.value, dtype=float).copy()
+    media = _media(comp, g)
+    if media is not None:
+        _put(out, "media_scale", ["media_scale"], idx, n, media[:, None])
+        if setup.media_in_model:
+            value += setup.media_scale * media
+    out.value[idx] = value
+    out.to_los[idx] = np.broadcast_to(comp.to_los, value.shape)
+    out.status[idx] = np.where(np.isfinite(value), "", "not computable (ramp coverage, band or frequency missing)")
+    for k, v in comp.params.items():
+        v = np.asarray(v, dtype=float)
+        v = v[:, None] if v.ndim == 1 else v
+        names = {"bias": ["bias"], "delay": ["delay_s"]}.get(k.split(":")[0])
+        if k.startswith("oscillator:"):
+            names = ["freq_bias_hz", "freq_drift_hz_s"]
+        elif k.startswith("clock:"):
+            names = ["c_a0", "c_a1", "c_a2"]
+        _put(out, k, names, idx, n, v)
+    done = set()
+    for role, (kind, name, obj) in roles.items():
+        if kind == "station":
+            _put(out, f"station:{name}", ["x", "y", "z"], idx, n, station_partials(comp, role, obj))
+        elif (name, role) not in done:
+            done.add((name, role))
+            _put(out, f"state:{name}", ["x", "y", "z", "vx", "vy", "vz"], idx, n, epoch_state_partials(comp, role, obj))
+            if getattr(obj, "param_names", None):
+                _put(out, f"dynamic:{name}", list(obj.param_names), idx, n, dynamic_partials(comp, role, obj))
+
+
+def _put(out: Evaluation, key, names, idx, n, block):
+    if key not in out.partials:
+        out.partials[key] = np.zeros((n, block.shape[1]))
+        out.names[key] = list(names) if names else [key]
+    out.partials[key][idx] += block
