@@ -171,7 +171,8 @@ def test_grail_first_time_matches_file_name_and_outliers_kept(shared_data, name)
     assert one["uplink_hz"].notna().all() and (one["station_tx"] == "").all()
     assert (t["validity"] == 0).all() and (t["flags"] == 0).all()
     assert t["value"].abs().max() > 1e7  # gross outliers flagged valid are kept
-    # one-way references are S-band scaled: GRAIL-B transmits on 2280.6 MHz (S) and 8451.8 MHz (X)
+    # one-way references are S-band scaled: scaled to the downlink band they land on round
+    # channel frequencies (2280.6 MHz S, 8451.8 MHz X), which they do not at S-band scale for X
     scale = one["band_down"].map({"S": 1.0, "X": 880 / 240})
     assert set(np.round(one["reference_hz"] * scale / 1e5) / 10) == {2280.6, 8451.8}
 
