@@ -164,7 +164,7 @@ def fit(problem: Problem, obs: Observations, t_start: float, t_end: float,
             if rows.size:
                 computed, H = problem.predict(grid[k], xr, rows)
                 y = obs.value[rows] - computed
-                nu, s = srif.innovations(H, y, sig_row[rows])
+                nu, s = srif.innovations(H, y, sig_row[rows], filt[-1])
                 bad = np.abs(nu) > kk * s
                 flags[rows[bad]] |= EDIT_INNOVATION
                 prefit[rows], innov[rows], innov_sig[rows] = y, nu, s

@@ -20,14 +20,23 @@ square-root information smoother backwards.
 from __future__ import annotations
 
 from dataclasses import dataclass
+from functools import lru_cache
 
 import numpy as np
-from scipy.linalg.lapack import dtrtri
+from scipy.linalg.lapack import dgeqrf, dgesv, dtrtri
+
+
+@lru_cache(maxsize=64)
+def _strictly_lower(k: int, n: int):
+    return np.tril_indices(k, -1, n)
 
 
 def triangularize(A: np.ndarray) -> np.ndarray:
     """Upper-triangular factor of ``A`` by Householder QR (rows ``min(m, n)``)."""
-    return np.linalg.qr(A, mode="r")
+    k = min(A.shape)
+    T = dgeqrf(A)[0][:k]
+    T[_strictly_lower(k, A.shape[1])] = 0.0
+    return T
 
 
 @dataclass(frozen=True)
@@ -47,19 +56,22 @@ class Gaussian:
         return np.sqrt(np.diag(self.P_consider))
 
 
-def solve_information(R, z, n_est, c_bar, c_sigma) -> Gaussian:
-    """Estimate and covariances from an information array (any row order)."""
+def solve_information(R, z, n_est, c_bar, c_sigma, triangular=False) -> Gaussian:
+    """Estimate and covariances from an information array (any row order unless
+    ``triangular``, which skips the re-triangularization)."""
     n = R.shape[1]
-    T = triangularize(np.column_stack([R, z]))
+    T = np.column_stack([R, z]) if triangular else triangularize(np.column_stack([R, z]))
     Ree, Rec, ze = T[:n_est, :n_est], T[:n_est, n_est:n], T[:n_est, n]
     Rinv, info = dtrtri(Ree)
     if info != 0:
         raise np.linalg.LinAlgError("singular square-root information matrix")
     S = Rinv @ Rec                          # -d(x_e)/d(c)
     x = np.concatenate([Rinv @ (ze - Rec @ c_bar), c_bar])
-    Pcc = np.diag(c_sigma**2)
     P = np.zeros((n, n))
     P[:n_est, :n_est] = Rinv @ Rinv.T
+    if n_est == n:
+        return Gaussian(x, P, P)
+    Pcc = np.diag(c_sigma**2)
     P[n_est:, n_est:] = Pcc
     Pc = P.copy()
     SP = S @ Pcc
@@ -73,9 +85,9 @@ class SRIF:
     """Square-root information filter on an ``n``-vector, the last ``n - n_est`` considered."""
 
     def __init__(self, R, z, n_est=None, c_bar=None, c_sigma=None):
-        self.R = np.array(R, dtype=float)
-        self.z = np.array(z, dtype=float)
-        n = self.R.shape[1]
+        n = np.shape(R)[1]
+        T = triangularize(np.column_stack([np.asarray(R, float), np.asarray(z, float)]))
+        self.R, self.z = T[:n, :n], T[:n, n]
         self.n_est = n if n_est is None else int(n_est)
         nc = n - self.n_est
         self.c_bar = np.zeros(nc) if c_bar is None else np.asarray(c_bar, float)
@@ -99,21 +111,25 @@ class SRIF:
         self.R, self.z = T[: self.n, : self.n], T[: self.n, self.n]
 
     # -- updates ---------------------------------------------------------
-    def measurement_update(self, H, y, sigma) -> np.ndarray:
-        """Absorb rows ``H dx = y`` with noise ``sigma``; return whitened post-update residuals."""
+    def measurement_update(self, H, y, sigma) -> float:
+        """Absorb rows ``H dx = y`` with noise ``sigma``; return their contribution to
+        the whitened residual sum of squares (also accumulated in ``chi2``)."""
         w = 1.0 / np.asarray(sigma, float)
         H = np.atleast_2d(H)
         A = np.vstack([np.column_stack([self.R, self.z]),
                        np.column_stack([H * w[:, None], np.asarray(y) * w])])
         T = triangularize(A)
         self._set(T)
-        e = T[self.n :, self.n] if T.shape[0] > self.n else np.zeros(0)
-        self.chi2 += float(e @ e)
-        return e
+        e2 = float(T[self.n, self.n] ** 2) if T.shape[0] > self.n else 0.0
+        self.chi2 += e2
+        return e2
 
     def time_update(self, Phi):
         """Deterministic map ``dx+ = Phi dx`` (Phi invertible, n x n)."""
-        RPhiInv = np.linalg.solve(Phi.T, self.R.T).T
+        lu, piv, RPhiInvT, info = dgesv(Phi.T, self.R.T)
+        if info != 0:
+            raise np.linalg.LinAlgError("singular transition matrix")
+        RPhiInv = RPhiInvT.T
         self._set(triangularize(np.column_stack([RPhiInv, self.z])))
         self.log.append(("map", Phi))
 
@@ -149,15 +165,17 @@ class SRIF:
 
     # -- read-out ---------------------------------------------------------
     def gaussian(self) -> Gaussian:
-        return solve_information(self.R, self.z, self.n_est, self.c_bar, self.c_sigma)
+        return solve_information(self.R, self.z, self.n_est, self.c_bar, self.c_sigma,
+                                 triangular=True)
 
-    def innovations(self, H, y, sigma):
+    def innovations(self, H, y, sigma, g: Gaussian | None = None):
         """Pre-update residuals ``y - H x`` and their predicted standard deviations.
 
         The prediction variance includes the estimate's covariance with the
-        consider parameters' effect, and the measurement noise.
+        consider parameters' effect, and the measurement noise. ``g``: the current
+        :meth:`gaussian`, if already computed.
         """
-        g = self.gaussian()
+        g = self.gaussian() if g is None else g
         H = np.atleast_2d(H)
         nu = np.asarray(y) - H @ g.x
         s2 = np.sum((H @ g.P_consider) * H, axis=1) + np.asarray(sigma, float) ** 2
