@@ -6,13 +6,14 @@ import numpy as np
 import pytest
 
 from odpipe.environment.eop import ARCSEC, default_eop, eop_at, iers_data_dir, read_jpl_eop
+from odpipe.environment.eop_tides import _orthotide_partials, ocean_tide_eop
 
 
 def test_values_at_nodes_equal_the_published_c04_row():
     # IERS 20 C04 row for 2012-04-08 (MJD 56025), read here independently of the module's parser
     row = next(line.split() for line in (iers_data_dir() / "eopc04.1962-now").read_text().splitlines()
                if not line.startswith("#") and line.split()[4] == "56025.00")
-    v = eop_at(np.datetime64("2012-04-08T00:00"))
+    v = eop_at(np.datetime64("2012-04-08T00:00"), ocean_tides=False)
     assert v.xp == pytest.approx(float(row[5]) * ARCSEC, abs=1e-15)
     assert v.yp == pytest.approx(float(row[6]) * ARCSEC, abs=1e-15)
     assert v.ut1_utc == pytest.approx(float(row[7]), abs=1e-12)
@@ -52,3 +53,26 @@ def test_malformed_jpl_eop_names_the_line(tmp_path):
     p.write_text(" EOP=\n 53511.0,  -72.44,  328.40,  32.613341,  32.0,  -52.83,   -4.68, $ ok\n 53512.0, x\n")
     with pytest.raises(ValueError, match="bad.EOP:3"):
         read_jpl_eop(p)
+
+
+def test_ocean_tide_eop_matches_the_iers_test_cases():
+    # IERS Conventions software ORTHO_EOP test case: MJD 47100 ->
+    # dx = -162.8386373279636530 µas, dy = 117.7907525842668974 µas, dUT1 = -23.39092370609808214 µs
+    dx, dy, dut1 = ocean_tide_eop(47100.0)
+    np.testing.assert_allclose([dx, dy, dut1], [-162.8386373279636530, 117.7907525842668974, -23.39092370609808214],
+                               rtol=0, atol=1e-9)
+    # CNMTX test case: MJD 54964 -> the 12 orthotide partials h(1..12)
+    h = _orthotide_partials(np.array(54964.0))
+    np.testing.assert_allclose(h, [15.35873641938967360, 9.784941251812741214, -5.520740128266865554,
+                                   3.575314211234633888, -13.93717453496387648, -9.167400321705855504,
+                                   5.532815475865292321, 9.558741883500834646, -10.22541212627272600,
+                                   0.8367570529461261231, 1.946355176475630611, -13.55702062247304696],
+                               rtol=0, atol=1e-9)
+
+
+def test_ocean_tides_are_added_to_interpolated_eop():
+    t = np.arange(np.datetime64("2012-04-08T00:00"), np.datetime64("2012-04-09T00:00"), np.timedelta64(1, "h"))
+    with_tides, without = eop_at(t), eop_at(t, ocean_tides=False)
+    ut1 = with_tides.ut1_utc - without.ut1_utc
+    assert 5e-6 < np.abs(ut1).max() < 1e-4   # tens of µs, diurnal/semidiurnal
+    assert np.abs(with_tides.xp - without.xp).max() < 1e-3 * ARCSEC

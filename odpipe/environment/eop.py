@@ -5,8 +5,9 @@ IERS 20 C04 series (``eopc04.1962-now``, final values, daily at 0h UTC) and,
 after its last day, IERS Bulletin A (``finals2000A.all``, rapid values and
 predictions). Values are interpolated with 4-point Lagrange polynomials;
 UT1−UTC is interpolated as UT1−TAI so that leap seconds do not corrupt it.
-Diurnal/sub-diurnal tidal EOP terms (IERS Conventions 2010 §5.5.1, ≲0.5 mas,
-≲0.05 ms) are not added.
+The diurnal/semidiurnal ocean-tide terms (IERS Conventions 2010 §8.2, ≲0.5 mas,
+≲0.05 ms) are added by default; the sub-diurnal libration terms (§5.5.1,
+< 0.03 mas, < 3 µs: < 1 mm) are not.
 
 Units out: s for UT1−UTC and LOD, rad for xp, yp, dX, dY.
 """
@@ -20,13 +21,15 @@ from pathlib import Path
 import numpy as np
 
 import astropy_iers_data
-from odpipe.environment.interpolation import lagrange4_uniform
+from odpipe.environment.eop_tides import ocean_tide_eop
+from odpipe.environment.interpolation import lagrange4_uniform, on_uniform_grid
 from odpipe.time.leap_seconds import NS_PER_DAY, tai_minus_utc_ns
 from odpipe.time.scales import as_utc_ns
 
 ARCSEC = np.pi / (180.0 * 3600.0)
 _MJD_UNIX = 40587
 _MJD_1972 = 41317
+_TIDE_GRID_DAYS = 1.0 / 96.0
 
 
 @dataclass(frozen=True)
@@ -71,8 +74,12 @@ class EOPTable:
         to = lambda m: np.datetime64(int(round((m - _MJD_UNIX) * 86400)), "s")  # noqa: E731
         return to(self.mjd[0]), to(self.mjd[-1])
 
-    def at(self, epoch_utc) -> EOPValues:
-        """Interpolated EOP at UTC epochs; ValueError naming the first epoch outside the table."""
+    def at(self, epoch_utc, ocean_tides: bool = True) -> EOPValues:
+        """Interpolated EOP at UTC epochs; ValueError naming the first epoch outside the table.
+
+        ``ocean_tides`` adds the diurnal/semidiurnal ocean-tide terms of xp, yp and UT1
+        (IERS ORTHO_EOP, :mod:`odpipe.environment.eop_tides`), which daily series omit.
+        """
         ns = as_utc_ns(epoch_utc)
         mjd = ns / NS_PER_DAY + _MJD_UNIX
         bad = (mjd < self.mjd[0]) | (mjd > self.mjd[-1])
@@ -82,8 +89,14 @@ class EOPTable:
             raise ValueError(f"EOP requested at {first} UTC, outside the table {self.source} ({lo} .. {hi})")
         cols = np.stack([self.ut1_tai, self.xp, self.yp, self.dx, self.dy, self.lod], axis=-1)
         v = lagrange4_uniform(self.mjd[0], 1.0, cols, np.ravel(mjd)).reshape(np.shape(mjd) + (6,))
-        ut1_utc = v[..., 0] + tai_minus_utc_ns(ns) * 1e-9
-        return EOPValues(ut1_utc, v[..., 1], v[..., 2], v[..., 3], v[..., 4], v[..., 5])
+        dat = tai_minus_utc_ns(ns) * 1e-9
+        ut1_utc, xp, yp = v[..., 0] + dat, v[..., 1], v[..., 2]
+        if ocean_tides:
+            tides = on_uniform_grid(lambda d: np.stack(ocean_tide_eop(d), axis=-1), mjd + (dat + 32.184) / 86400.0,
+                                    _TIDE_GRID_DAYS)  # shortest period ~0.5 d: grid error < 1e-5 relative
+            dx, dy, dut1 = tides[..., 0], tides[..., 1], tides[..., 2]
+            ut1_utc, xp, yp = ut1_utc + dut1 * 1e-6, xp + dx * 1e-6 * ARCSEC, yp + dy * 1e-6 * ARCSEC
+        return EOPValues(ut1_utc, xp, yp, v[..., 3], v[..., 4], v[..., 5])
 
 
 def iers_data_dir() -> Path:
@@ -135,9 +148,9 @@ def default_eop() -> EOPTable:
     return EOPTable.from_columns(source=f"{d / 'eopc04.1962-now'} + finals2000A.all", **cols)
 
 
-def eop_at(epoch_utc) -> EOPValues:
-    """EOP from the default IERS tables at UTC epochs."""
-    return default_eop().at(epoch_utc)
+def eop_at(epoch_utc, ocean_tides: bool = True) -> EOPValues:
+    """EOP from the default IERS tables at UTC epochs (with ocean-tide terms unless disabled)."""
+    return default_eop().at(epoch_utc, ocean_tides)
 
 
 def read_jpl_eop(path) -> EOPTable:

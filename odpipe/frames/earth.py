@@ -21,7 +21,7 @@ from odpipe.environment.eop import EOPValues, eop_at
 from odpipe.environment.interpolation import on_uniform_grid
 from odpipe.frames.epochs import utc_and_tt
 from odpipe.frames.rotations import frame_rotation
-from odpipe.time.leap_seconds import NS_PER_DAY
+from odpipe.time.leap_seconds import NS_PER_DAY, tai_minus_utc_ns
 from odpipe.time.scales import J2000_JD, J2000_NS
 
 ERA_RATE = 2.0 * np.pi * 1.00273781191135448 / 86400.0  # rad per UT1 second (IERS 2010 eq. 5.15)
@@ -32,13 +32,14 @@ _CIP_GRID_MIN_EPOCHS = 200
 @dataclass(frozen=True)
 class EarthRotation:
     """The three factors of GCRS→ITRS: ``rpom @ R3(era) @ rc2i``, Earth's rotation rate ``omega`` (rad/s)
-    and, when asked for, the time derivative of ``rc2i`` (1/s, precession-nutation)."""
+    and, when asked for, the time derivatives (1/s) of ``rc2i`` and ``rpom`` (None when not known)."""
 
     rc2i: np.ndarray
     era: np.ndarray
     rpom: np.ndarray
     omega: np.ndarray
     rc2i_rate: np.ndarray | None = None
+    rpom_rate: np.ndarray | None = None
 
     @property
     def gcrs_to_itrs(self) -> np.ndarray:
@@ -66,25 +67,37 @@ def _rc2i(tt_days, dx, dy) -> np.ndarray:
 
 
 _RATE_STEP_DAYS = 1.0 / 24.0  # central difference over ±1 h: rate error < 1e-3 relative (shortest terms ~5 d)
+_EOP_RATE_STEP_S = 600.0      # ±10 min for UT1 and pole rates (tidal terms ≥ 0.5 d period: 1e-3 relative)
 
 
 def earth_rotation(t, eop: EOPValues | None = None, with_rate: bool = False) -> EarthRotation:
     """Factors of the GCRS→ITRS rotation at epochs ``t`` (EOP interpolated unless given).
 
     ``with_rate`` adds the precession-nutation rate of ``rc2i`` (≈5e-5 m/s at the
-    Earth's surface, needed for station velocities at Doppler precision).
+    Earth's surface, needed for station velocities at Doppler precision) and,
+    with interpolated EOP, takes ω and the polar-motion rate from the EOP
+    themselves (tidal UT1 and pole included). Given constant ``eop``, ω uses its LOD.
     """
     utc, tt_days = utc_and_tt(t)
     e = eop if eop is not None else eop_at(utc.astype("datetime64[ns]"))
     rc2i = _rc2i(tt_days, e.dx, e.dy)
-    rate = None
-    if with_rate:
-        h = _RATE_STEP_DAYS
-        rate = (_rc2i(tt_days + h, e.dx, e.dy) - _rc2i(tt_days - h, e.dx, e.dy)) / (2 * h * 86400.0)
+    sp = erfa.sp00(J2000_JD, tt_days)
+    rpom = erfa.pom00(e.xp, e.yp, sp)
     days, rem_ns = np.divmod(utc - J2000_NS, NS_PER_DAY)  # whole + fraction keeps ERA at 1e-16 rad
     era = erfa.era00(J2000_JD + days, rem_ns / NS_PER_DAY + e.ut1_utc / 86400.0)
-    rpom = erfa.pom00(e.xp, e.yp, erfa.sp00(J2000_JD, tt_days))
-    return EarthRotation(rc2i, era, rpom, ERA_RATE * (1.0 - e.lod / 86400.0), rate)
+    omega = ERA_RATE * (1.0 - e.lod / 86400.0)
+    rc2i_rate = rpom_rate = None
+    if with_rate:
+        h = _RATE_STEP_DAYS
+        rc2i_rate = (_rc2i(tt_days + h, e.dx, e.dy) - _rc2i(tt_days - h, e.dx, e.dy)) / (2 * h * 86400.0)
+        if eop is None:
+            step = np.int64(_EOP_RATE_STEP_S * 1e9)
+            ep = eop_at((utc + step).astype("datetime64[ns]"))
+            em = eop_at((utc - step).astype("datetime64[ns]"))
+            jump = (tai_minus_utc_ns(utc + step) - tai_minus_utc_ns(utc - step)) * 1e-9  # a leap second inside
+            omega = ERA_RATE * (1.0 + (ep.ut1_utc - em.ut1_utc - jump) / (2 * _EOP_RATE_STEP_S))
+            rpom_rate = (erfa.pom00(ep.xp, ep.yp, sp) - erfa.pom00(em.xp, em.yp, sp)) / (2 * _EOP_RATE_STEP_S)
+    return EarthRotation(rc2i, era, rpom, omega, rc2i_rate, rpom_rate)
 
 
 def gcrs_to_itrs(t, eop: EOPValues | None = None) -> np.ndarray:
@@ -108,15 +121,17 @@ def _mtv(m: np.ndarray, v: np.ndarray) -> np.ndarray:
 def itrs_to_gcrs_state(t, r_itrs, v_itrs=None, eop: EOPValues | None = None):
     """GCRS position (m) and velocity (m/s) of ITRS positions/velocities at epochs ``t``.
 
-    The velocity includes Earth rotation, ω × r with ω = ERA rate·(1 − LOD/86400)
-    about the CIP, and the precession-nutation rate; the polar-motion rate
-    (< 1e-6 m/s at the surface) is neglected. ``v_itrs`` defaults to zero (a
+    The velocity includes Earth rotation ω × r (ω from UT1's rate, tidal terms
+    included) about the CIP, the precession-nutation rate and, with
+    interpolated EOP, the polar-motion rate. ``v_itrs`` defaults to zero (a
     point fixed on the Earth).
     """
     rot = earth_rotation(t, eop, with_rate=True)
     r = np.asarray(r_itrs, dtype=float)
     r_tirs = _mtv(rot.rpom, r)
     v_tirs = np.zeros_like(r_tirs) if v_itrs is None else _mtv(rot.rpom, np.asarray(v_itrs, dtype=float))
+    if rot.rpom_rate is not None:
+        v_tirs = v_tirs + _mtv(rot.rpom_rate, r)
     w = np.asarray(rot.omega)[..., None]
     v_tirs = v_tirs + w * np.stack([-r_tirs[..., 1], r_tirs[..., 0], np.zeros_like(r_tirs[..., 0])], axis=-1)
     rz = frame_rotation(3, rot.era)
@@ -125,13 +140,15 @@ def itrs_to_gcrs_state(t, r_itrs, v_itrs=None, eop: EOPValues | None = None):
 
 
 def gcrs_to_itrs_state(t, r_gcrs, v_gcrs=None, eop: EOPValues | None = None):
-    """ITRS position (m) and velocity (m/s) from GCRS position/velocity at epochs ``t``."""
+    """ITRS position (m) and velocity (m/s) from GCRS position/velocity at epochs ``t`` (inverse of the above)."""
     rot = earth_rotation(t, eop, with_rate=True)
     rz = frame_rotation(3, rot.era)
     r = np.asarray(r_gcrs, dtype=float)
     v_cirs = _mv(rot.rc2i_rate, r) + (0.0 if v_gcrs is None else _mv(rot.rc2i, np.asarray(v_gcrs, dtype=float)))
     r_tirs = _mv(rz, _mv(rot.rc2i, r))
-    v_tirs = _mv(rz, v_cirs)
     w = np.asarray(rot.omega)[..., None]
-    v_tirs = v_tirs - w * np.stack([-r_tirs[..., 1], r_tirs[..., 0], np.zeros_like(r_tirs[..., 0])], axis=-1)
-    return _mv(rot.rpom, r_tirs), _mv(rot.rpom, v_tirs)
+    v_tirs = _mv(rz, v_cirs) - w * np.stack([-r_tirs[..., 1], r_tirs[..., 0], np.zeros_like(r_tirs[..., 0])], axis=-1)
+    v_itrs = _mv(rot.rpom, v_tirs)
+    if rot.rpom_rate is not None:
+        v_itrs = v_itrs + _mv(rot.rpom_rate, r_tirs)
+    return _mv(rot.rpom, r_tirs), v_itrs
