@@ -30,9 +30,15 @@ def test_tai_minus_utc_matches_sofa_dat_every_month():
     np.testing.assert_array_equal(ours, sofa)
 
 
-def test_before_1972_is_an_error_naming_the_epoch():
+def test_before_1972_and_missing_epochs_are_errors():
     with pytest.raises(ValueError, match="1969-07-20"):
         T.utc_to_tdb(np.datetime64("1969-07-20T20:17"))
+    with pytest.raises(ValueError, match="NaT"):
+        T.utc_to_tdb(np.array(["2012-01-01", "NaT"], dtype="datetime64[ns]"))
+    with pytest.raises(ValueError, match="NaN"):
+        T.tdb_to_utc(np.array([0.0, np.nan]))
+    with pytest.raises(TypeError, match="datetime64"):
+        T.utc_to_tdb(np.array([1.0, 2.0]))
 
 
 def test_tt_and_tai_offsets():

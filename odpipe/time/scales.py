@@ -110,6 +110,8 @@ def utc_to_tdb(epoch_utc, station_itrs=None) -> np.ndarray:
 def split_tdb(t_tdb) -> tuple[np.ndarray, np.ndarray]:
     """Two-part form ``(whole int64, frac float64)`` of float TDB s (exact split)."""
     t = np.asarray(t_tdb, dtype=float)
+    if not np.all(np.isfinite(t)):
+        raise ValueError("TDB epochs contain NaN or infinity")
     whole = np.floor(t)
     return whole.astype(np.int64), t - whole
 
