@@ -10,8 +10,6 @@ These are NOT the product's dynamics or measurement models (see
   accelerations (inertial axes), impulsive maneuvers, ground-station range /
   range-rate with per-station range biases; fixed-step RK4 of state, STM and
   acceleration sensitivities (numba).
-* :func:`crtbp_problem` -- two spacecraft in the Earth-Moon CRTBP (rotating
-  frame, dimensional) with inter-satellite range / range-rate (LiAISON).
 """
 
 from __future__ import annotations
@@ -64,65 +62,24 @@ def _twobody_deriv(y, p, out):
     for i in range(3):
         for j in range(3):
             G[i, j] = 3 * mu * r[i] * r[j] / rn**5 - (mu / rn**3 if i == j else 0.0)
-    _variational(y, G, np.zeros((3, 3)), out)
+    _variational(y, G, out)
 
 
 @njit(cache=True)
-def _crtbp_deriv(y, p, out):
-    """Rotating-frame CRTBP; p = [mu1, mu2, L, omega, ax, ay, az] (SI)."""
-    mu1, mu2, L, w = p[0], p[1], p[2], p[3]
-    mu = mu2 / (mu1 + mu2)
-    r = y[0:3]
-    v = y[3:6]
-    d1 = r.copy()
-    d1[0] += mu * L
-    d2 = r.copy()
-    d2[0] -= (1 - mu) * L
-    n1 = np.sqrt(d1 @ d1)
-    n2 = np.sqrt(d2 @ d2)
-    out[0:3] = v
-    out[3:6] = -mu1 * d1 / n1**3 - mu2 * d2 / n2**3 + p[4:7]
-    out[3] += w * w * r[0] + 2 * w * v[1]
-    out[4] += w * w * r[1] - 2 * w * v[0]
-    G = np.empty((3, 3))
-    for i in range(3):
-        for j in range(3):
-            G[i, j] = (3 * mu1 * d1[i] * d1[j] / n1**5 + 3 * mu2 * d2[i] * d2[j] / n2**5
-                       - (mu1 / n1**3 + mu2 / n2**3 if i == j else 0.0))
-    G[0, 0] += w * w
-    G[1, 1] += w * w
-    C = np.zeros((3, 3))
-    C[0, 1] = 2 * w
-    C[1, 0] = -2 * w
-    _variational(y, G, C, out)
-
-
-@njit(cache=True)
-def _variational(y, G, C, out):
-    """d/dt S = [[0, I], [G, C]] S + [0; I] on the acceleration columns (last three)."""
+def _variational(y, G, out):
+    """d/dt S = [[0, I], [G, 0]] S + [0; I] on the acceleration columns (last three)."""
     k = (y.size - 6) // 6
     S = y[6:].reshape(6, k)
     D = np.zeros((6, k))
     D[0:3] = S[3:6]
-    D[3:6] = G @ S[0:3] + C @ S[3:6]
+    D[3:6] = G @ S[0:3]
     for i in range(3):
         D[3 + i, k - 3 + i] += 1.0
     out[6:] = D.ravel()
 
 
-TWOBODY, CRTBP = 0, 1
-
-
 @njit(cache=True)
-def _deriv(model, y, p, out):
-    if model == TWOBODY:
-        _twobody_deriv(y, p, out)
-    else:
-        _crtbp_deriv(y, p, out)
-
-
-@njit(cache=True)
-def _rk4(model, y0, t0, times, h, p):
+def _rk4(y0, t0, times, h, p):
     """Fixed-step RK4 from t0 through sorted ``times`` (>= t0); returns states at times."""
     out = np.empty((times.size, y0.size))
     y = y0.copy()
@@ -134,23 +91,21 @@ def _rk4(model, y0, t0, times, h, p):
     for i in range(times.size):
         while t < times[i]:
             dt = min(h, times[i] - t)
-            _deriv(model, y, p, k1)
-            _deriv(model, y + 0.5 * dt * k1, p, k2)
-            _deriv(model, y + 0.5 * dt * k2, p, k3)
-            _deriv(model, y + dt * k3, p, k4)
+            _twobody_deriv(y, p, k1)
+            _twobody_deriv(y + 0.5 * dt * k1, p, k2)
+            _twobody_deriv(y + 0.5 * dt * k2, p, k3)
+            _twobody_deriv(y + dt * k3, p, k4)
             y = y + dt / 6 * (k1 + 2 * k2 + 2 * k3 + k4)
             t += dt
         out[i] = y
     return out
 
 
-def flow(model, p_const, x0, acc, t0, times, h):
-    """States (m, 6) and sensitivities (m, 6, 9) to [x0, acc] at ``times``.
-
-    model: TWOBODY (p_const = [mu]) or CRTBP (p_const = [mu1, mu2, L, omega])."""
+def flow(x0, acc, t0, times, h):
+    """Two-body states (m, 6) and sensitivities (m, 6, 9) to [x0, acc] at ``times``."""
     y0 = np.concatenate([x0, np.hstack([np.eye(6), np.zeros((6, 3))]).ravel()])
-    Y = _rk4(model, y0, float(t0), np.asarray(times, float), h,
-             np.concatenate([p_const, acc]))
+    Y = _rk4(y0, float(t0), np.asarray(times, float), h,
+             np.concatenate([[MU_EARTH], acc]))
     return Y[:, :6], Y[:, 6:].reshape(-1, 6, 9)
 
 
@@ -213,7 +168,7 @@ class TwoBodyProblem:
 
     def transition(self, t0, t1, x0):
         s, dv_idx = self._start(t0, x0)
-        X, S = flow(TWOBODY, np.array([MU_EARTH]), s, self._acc(x0), t0, [t1], self.h)
+        X, S = flow(s, self._acc(x0), t0, [t1], self.h)
         Phi = np.eye(len(self.registry))
         Phi[self.i_state] = self._registry_sens(S, dv_idx, 1)[0]
         x1 = x0.copy()
@@ -223,7 +178,7 @@ class TwoBodyProblem:
     def predict(self, t0, x0, rows):
         s, dv_idx = self._start(t0, x0)
         t = self.times[rows]
-        X, S = flow(TWOBODY, np.array([MU_EARTH]), s, self._acc(x0), t0, t, self.h)
+        X, S = flow(s, self._acc(x0), t0, t, self.h)
         D = self._registry_sens(S, dv_idx, rows.size)
         st = self.station[rows]
         rs, vs = station_states(self.stations, t)
