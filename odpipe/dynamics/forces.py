@@ -28,7 +28,7 @@ from typing import Callable, Sequence
 import numpy as np
 
 from odpipe.dynamics.chebyshev import fit_channel, stack_channels
-from odpipe.dynamics.harmonics import recursion_factors
+from odpipe.dynamics.harmonics import by_order, recursion_factors
 from odpipe.dynamics.srp import CYLINDER, P_SUN_1AU, PLATE, SUN_CYLINDER, SUN_PLATE
 from odpipe.environment.gravity import GravityField
 
@@ -221,8 +221,8 @@ def compile_model(fm: ForceModel, t0: float, t1: float, params: Sequence[str], w
     channels = []
     for k, s in enumerate(sh_list):
         g = s.field.truncated(s.degree)
-        C[k, : s.degree + 1, : s.degree + 1] = g.C
-        S[k, : s.degree + 1, : s.degree + 1] = g.S
+        C[k, : s.degree + 1, : s.degree + 1] = by_order(g.C)
+        S[k, : s.degree + 1, : s.degree + 1] = by_order(g.S)
         ngrad = (s.degree if s.partial_degree is None else s.partial_degree) if with_stm else -1
         body = s.body.lower()
         rot = s.rotation or _default_rotation(body)
