@@ -50,7 +50,7 @@ from .bands import C_LIGHT
 from .nodes import origin_state
 
 _MAXITER = 12
-_TOL = 1e-15  # s, change of tau at which a leg counts as converged
+_TOL = 1e-9  # s: a Newton step this small leaves an error below 1e-25 s (applied without re-evaluating)
 
 
 @numba.njit(cache=True)
@@ -133,7 +133,7 @@ def _shifted(t, corr, dt):
 
 
 def _state_at(node, te, ce):
-    s = node.state(te).copy()
+    s = np.array(node.state(te), dtype=float)
     s[:, :3] += s[:, 3:] * ce[:, None]
     return s
 
@@ -180,13 +180,17 @@ def solve_path(nodes: Sequence, t_anchor, anchor: str = "receive", t_corr=None,
             sf = _state_at(nodes[free], te, ce)
             r_rx, r_tx = (sk[:, :3], sf[:, :3]) if anchor == "receive" else (sf[:, :3], sk[:, :3])
             new, shap = _leg_newton_step(r_rx, r_tx, sf[:, 3:], tau, bpos, bvel, kb, direction)
-            done = np.max(np.abs(new - tau)) < _TOL
+            step = direction * (new - tau)
             tau = new
-            if done:
+            if np.max(np.abs(step)) < _TOL:
+                # the remaining Newton error is ~ (rho''/2c) step^2 < 1e-25 s: move the state, no new evaluation
+                ce = ce + step
+                sf[:, :3] += sf[:, 3:] * step[:, None]
                 break
-        te, ce = _shifted(tk, ck, direction * tau)
+        else:
+            raise RuntimeError(f"light time did not converge on leg {leg}: last step {np.max(np.abs(step)):.3e} s")
         epochs[:, free], corr[:, free] = te, ce
-        states[:, free] = _state_at(nodes[free], te, ce)
+        states[:, free] = sf
         leg_time[:, leg] = tau
         shapiro[:, leg] = shap
 
@@ -196,32 +200,45 @@ def solve_path(nodes: Sequence, t_anchor, anchor: str = "receive", t_corr=None,
 
 def _chain_partials(states: np.ndarray, anchor: str) -> tuple[np.ndarray, np.ndarray]:
     """d(t_last - t_first)/d(event positions) (N,k+1,3) s/m, and d(t_last - t_first)/d(anchor), by chaining legs."""
+    return _chain_kernel(np.ascontiguousarray(states), anchor == "receive")
+
+
+@numba.njit(cache=True)
+def _chain_kernel(states, receive):
+    """Per row: walk the legs away from the anchor, carrying the gradient of the floating epoch.
+
+    Receive anchor: dt_{j-1} = (1-b) dt_j - a.dr_j + a.dr_{j-1}; transmit anchor:
+    dt_j = (1+b) dt_{j-1} + a.dr_j - a.dr_{j-1}; a = n/(c - n.v_free), b = n.(v_R - v_T)/(c - n.v_free).
+    """
     n, kp1, _ = states.shape
-    g = np.zeros((n, kp1, kp1, 3))  # g[:, j] = gradient of event j's epoch
-    dt = np.ones(n)  # d(current epoch)/d(anchor epoch)
-    legs = range(kp1 - 1, 0, -1) if anchor == "receive" else range(1, kp1)
-    for j in legs:
-        r_rx, v_rx = states[:, j, :3], states[:, j, 3:]
-        r_tx, v_tx = states[:, j - 1, :3], states[:, j - 1, 3:]
-        d = r_rx - r_tx
-        u = d / np.linalg.norm(d, axis=1)[:, None]
-        v_free = v_tx if anchor == "receive" else v_rx
-        den = C_LIGHT - np.einsum("ni,ni->n", u, v_free)
-        a = u / den[:, None]
-        b = np.einsum("ni,ni->n", u, v_rx - v_tx) / den
-        if anchor == "receive":  # dt_{j-1} = (1-b) dt_j - a.dr_j + a.dr_{j-1}
-            g[:, j - 1] = (1.0 - b)[:, None, None] * g[:, j]
-            g[:, j - 1, j] -= a
-            g[:, j - 1, j - 1] += a
-            dt = dt * (1.0 - b)
-        else:  # dt_j = (1+b) dt_{j-1} + a.dr_j - a.dr_{j-1}
-            g[:, j] = (1.0 + b)[:, None, None] * g[:, j - 1]
-            g[:, j, j] += a
-            g[:, j, j - 1] -= a
-            dt = dt * (1.0 + b)
-    if anchor == "receive":
-        return -g[:, 0], 1.0 - dt
-    return g[:, -1], dt - 1.0
+    out = np.zeros((n, kp1, 3))
+    rate = np.empty(n)
+    g = np.zeros((kp1, 3))
+    for r in range(n):
+        g[:, :] = 0.0
+        dt = 1.0
+        for step in range(1, kp1):
+            j = kp1 - step if receive else step
+            u = states[r, j, :3] - states[r, j - 1, :3]
+            u = u / np.sqrt(u[0] ** 2 + u[1] ** 2 + u[2] ** 2)
+            v_free = states[r, j - 1, 3:] if receive else states[r, j, 3:]
+            den = C_LIGHT - (u[0] * v_free[0] + u[1] * v_free[1] + u[2] * v_free[2])
+            dv = states[r, j, 3:] - states[r, j - 1, 3:]
+            b = (u[0] * dv[0] + u[1] * dv[1] + u[2] * dv[2]) / den
+            f = 1.0 - b if receive else 1.0 + b
+            for m in range(kp1):
+                for i in range(3):
+                    g[m, i] *= f
+            sign = -1.0 if receive else 1.0
+            for i in range(3):
+                g[j, i] += sign * u[i] / den
+                g[j - 1, i] -= sign * u[i] / den
+            dt *= f
+        for m in range(kp1):
+            for i in range(3):
+                out[r, m, i] = -g[m, i] if receive else g[m, i]
+        rate[r] = 1.0 - dt if receive else dt - 1.0
+    return out, rate
 
 
 def anchor_from_utc(epoch_utc, offset_s=0.0) -> tuple[np.ndarray, np.ndarray]:
