@@ -70,8 +70,9 @@ def test_rotation_velocity_equals_finite_difference_and_state_round_trips():
 def test_dss14_gcrs_position_agrees_with_spice(shared_data):
     sp = pytest.importorskip("spiceypy")
     k = shared_data / "kernels"
-    for name in ("naif0012.tls", "earth_000101_190127_181105.bpc", "earthstns_itrf93_201023.bsp"):
-        sp.furnsh(str(k / name))
+    kernels = [str(k / n) for n in ("naif0012.tls", "earth_000101_190127_181105.bpc", "earthstns_itrf93_201023.bsp")]
+    for path in kernels:
+        sp.furnsh(path)
     try:
         dss14 = StationCatalog.default()["DSS-14"]
         for day in ("2006-02-27", "2012-04-08", "2017-06-01"):
@@ -89,4 +90,5 @@ def test_dss14_gcrs_position_agrees_with_spice(shared_data):
             assert np.linalg.norm(r - spice[:, :3], axis=1).max() < 0.10
             assert np.linalg.norm(v - spice[:, 3:], axis=1).max() < 2e-5  # m/s; measured 5e-6
     finally:
-        sp.kclear()
+        for path in kernels:  # only ours: other modules may hold kernels in the same session
+            sp.unload(path)

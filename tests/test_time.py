@@ -64,7 +64,8 @@ def test_tdb_minus_tt_equals_erfa_dtdb_with_station_terms():
 @pytest.mark.realdata
 def test_utc_to_tdb_agrees_with_spice(shared_data):
     sp = pytest.importorskip("spiceypy")
-    sp.furnsh(str(shared_data / "kernels" / "naif0012.tls"))
+    lsk = str(shared_data / "kernels" / "naif0012.tls")
+    sp.furnsh(lsk)
     try:
         iso = ["1980-01-06T00:00:00", "2006-02-27T12:34:56.5", "2012-04-08T06:20:00", "2016-12-31T23:59:59",
                "2017-01-01T00:00:00"]
@@ -73,7 +74,7 @@ def test_utc_to_tdb_agrees_with_spice(shared_data):
         # SPICE's TDB-TT is a 1-term formula (|error| < 30 µs against the full series used here)
         np.testing.assert_allclose(ours, spice, rtol=0, atol=3e-5)
     finally:
-        sp.kclear()
+        sp.unload(lsk)  # only ours: other modules may hold kernels in the same session
 
 
 def test_round_trip_utc_tdb_two_part_is_exact_to_the_ns():

@@ -52,9 +52,11 @@ def moon_pa_to_icrf(t_tdb, kernel: str | Path | None = None) -> np.ndarray:
     t = np.asarray(t_tdb, dtype=float)
     jd1, jd2 = jd_split(t)
     try:
-        phi, theta, psi = np.reshape(_libration_source(None if kernel is None else str(kernel))(jd1, jd2), (3, -1))
-    except Exception as err:  # jplephem raises its own DateError/ValueError types
-        raise ValueError(f"lunar librations unavailable for TDB {t.min():.1f}..{t.max():.1f} s past J2000: {err}") from err
+        angles = _libration_source(None if kernel is None else str(kernel))(jd1, jd2)
+    except ValueError as err:  # jplephem's DateError is a ValueError
+        raise ValueError(f"lunar librations unavailable for TDB {t.min():.1f}..{t.max():.1f} s past J2000: "
+                         f"{err}") from err
+    phi, theta, psi = np.reshape(angles, (3, -1))
     icrf_to_pa = frame_rotation(3, psi) @ frame_rotation(1, theta) @ frame_rotation(3, phi)
     return np.swapaxes(icrf_to_pa, -1, -2).reshape(t.shape + (3, 3))
 
@@ -62,7 +64,8 @@ def moon_pa_to_icrf(t_tdb, kernel: str | Path | None = None) -> np.ndarray:
 def moon_me_to_pa() -> np.ndarray:
     """Constant rotation Moon ME → PA (DE421 realization, NAIF moon_080317.tf)."""
     a3, a2, a1 = (x * ARCSEC for x in ME_DE421_ANGLES_ARCSEC)
-    return frame_rotation(3, a3) @ frame_rotation(2, a2) @ frame_rotation(1, a1)  # SPICE TKFRAME convention: frame -> RELATIVE
+    # SPICE TKFRAME convention: the rotation maps the frame (ME) to its RELATIVE frame (PA)
+    return frame_rotation(3, a3) @ frame_rotation(2, a2) @ frame_rotation(1, a1)
 
 
 def moon_me_to_icrf(t_tdb, kernel: str | Path | None = None) -> np.ndarray:
@@ -94,5 +97,6 @@ def moon_iau_to_icrf(t_tdb) -> np.ndarray:
     ra = _RA[0] + _RA[1] * cent + np.sin(e) @ _RA[2]
     dec = _DEC[0] + _DEC[1] * cent + np.cos(e) @ _DEC[2]
     w = _PM[0] + _PM[1] * d + _PM[2] * d**2 + np.sin(e) @ _PM[3]
-    icrf_to_body = frame_rotation(3, w * _DEG) @ frame_rotation(1, (90.0 - dec) * _DEG) @ frame_rotation(3, (90.0 + ra) * _DEG)
+    icrf_to_body = (frame_rotation(3, w * _DEG) @ frame_rotation(1, (90.0 - dec) * _DEG)
+                    @ frame_rotation(3, (90.0 + ra) * _DEG))
     return np.swapaxes(icrf_to_body, -1, -2)
