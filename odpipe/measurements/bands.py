@@ -34,15 +34,18 @@ RANGE_UNIT_FACTOR = {"S": 1 / 2, "X": 221 / (749 * 2), "Ka": 221 / (3599 * 2)}
 
 def turnaround_ratio(band_up, band_down) -> np.ndarray:
     """M2 = f_down/f_up per row (dimensionless); NaN where the band pair is unknown or one-way."""
-    up = np.atleast_1d(np.asarray(band_up, dtype=object))
-    down = np.broadcast_to(np.atleast_1d(np.asarray(band_down, dtype=object)), up.shape)
-    return np.array([TURNAROUND.get((_norm(u), _norm(d)), np.nan) for u, d in zip(up, down)])
+    up = np.atleast_1d(np.asarray(band_up, dtype=object)).astype(str)
+    down = np.broadcast_to(np.atleast_1d(np.asarray(band_down, dtype=object)).astype(str), up.shape)
+    pairs, inv = np.unique(np.char.add(np.char.add(up, "/"), down), return_inverse=True)
+    table = np.array([TURNAROUND.get(tuple(_norm(b) for b in p.split("/", 1)), np.nan) for p in pairs])
+    return table[inv.ravel()]
 
 
 def range_unit_factor(band_up) -> np.ndarray:
     """F per row (RU per uplink cycle); NaN for an unknown band."""
-    up = np.atleast_1d(np.asarray(band_up, dtype=object))
-    return np.array([RANGE_UNIT_FACTOR.get(_norm(u), np.nan) for u in up])
+    up = np.atleast_1d(np.asarray(band_up, dtype=object)).astype(str)
+    names, inv = np.unique(up, return_inverse=True)
+    return np.array([RANGE_UNIT_FACTOR.get(_norm(u), np.nan) for u in names])[inv.ravel()]
 
 
 def _norm(band) -> str:

@@ -113,8 +113,9 @@ class StationNode:
         t = np.atleast_1d(np.asarray(t, dtype=float))
         out = geocentric_tdb_minus_tt(t)
         if self.ephemeris is not None:
-            v_earth = origin_state(self.ephemeris, "earth", "ssb", t)[:, 3:]
-            r_geo = state[:, :3] - origin_state(self.ephemeris, "earth", self.origin, t)[:, :3]
+            earth = origin_state(self.ephemeris, "earth", self.origin, t)
+            v_earth = earth[:, 3:] if self.origin.lower() == "ssb" else origin_state(self.ephemeris, "earth", "ssb", t)[:, 3:]
+            r_geo = state[:, :3] - earth[:, :3]
             out = out + np.einsum("ni,ni->n", v_earth, r_geo) / C_LIGHT**2
         return out
 
