@@ -60,7 +60,9 @@ class FitOptions:
     post-fit RMS (whitened) is below edit_gate_rms, so that a far-off first
     reference does not reject good data; reweight: scale each group's sigma by
     its post-fit RMS; tol_dx: converged when every epoch correction < tol_dx sigma and
-    the post-fit RMS changed by < tol_rms (relative)."""
+    the post-fit RMS changed by < tol_rms (relative); extra_epochs: more grid epochs
+    (TDB s); output_at_measurements: put every observation time on the grid, so
+    filtered and smoothed estimates exist at each measurement time."""
 
     max_iter: int = 10
     block: float = 600.0
@@ -70,6 +72,7 @@ class FitOptions:
     tol_dx: float = 1e-2
     tol_rms: float = 1e-3
     extra_epochs: tuple = ()
+    output_at_measurements: bool = False
 
 
 @dataclass
@@ -134,7 +137,9 @@ def fit(problem: Problem, obs: Observations, t_start: float, t_end: float,
     n, n_est = len(reg), reg.n_estimated
     apriori, sig0 = reg.apriori, reg.sigma
     x_ref0 = apriori.copy() if x_ref is None else np.asarray(x_ref, float).copy()
-    grid, steps = build_grid(reg, t_start, t_end, options.block, options.extra_epochs)
+    extra = np.concatenate([np.asarray(options.extra_epochs, float),
+                            np.unique(obs.time) if options.output_at_measurements else []])
+    grid, steps = build_grid(reg, t_start, t_end, options.block, extra)
     K = grid.size - 1
     bounds = np.searchsorted(obs.time, grid, side="left")
     bounds[-1] = obs.time.size
