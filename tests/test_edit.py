@@ -32,11 +32,26 @@ def bits(table, flag):
 def test_blunders_found_exactly_on_a_noisy_orbit_signal():
     tab = sine_doppler()
     hit = np.array([5, 700, 701, 3000, 7199])
-    tab.loc[hit, "value"] += np.array([1e8, 0.5, -0.3, 2.0, -5e4])  # 60..1e10 sigma
+    tab.loc[hit, "value"] += np.array([1e8, 0.5, 5.0, 2.0, -5e4])  # 100..1e10 sigma
     out, summ = edit(tab)
     assert np.array_equal(np.flatnonzero(bits(out, Flag.BLUNDER)), hit)
     assert len(out) == len(tab)
     assert summ.set_index("reason").loc["blunder", "rows"] == len(hit)
+
+
+def test_slope_and_level_changes_are_not_blunders():
+    """Ramped Doppler: the rate changes every few minutes and the level jumps once (a retuning)."""
+    rng = np.random.default_rng(2)
+    t = np.arange(3600) + 0.5
+    rate = np.repeat(rng.uniform(-150.0, 150.0, 12), 300)           # Hz/s, 5-min ramp segments
+    v = np.cumsum(rate) + 5e3 * (t > 1800.2) + rng.normal(0, 0.005, len(t))
+    tab = sine_doppler(n=len(t))
+    tab["value"] = v
+    out, _ = edit(tab)
+    assert not bits(out, Flag.BLUNDER).any()
+    tab.loc[[905, 1805], "value"] += [3.0, -2.0]                      # 5 s after a rate change, after the jump
+    out, _ = edit(tab)
+    assert np.flatnonzero(bits(out, Flag.BLUNDER)).tolist() == [905, 1805]
 
 
 def test_duplicates_invalid_elevation_short_pass_arc_and_windows():
@@ -150,3 +165,19 @@ def test_grail_gross_outliers_are_flagged(shared_data, name):
     assert bits(out, Flag.BLUNDER)[tab["value"].abs().to_numpy() > 1e5].all()
     # editing is selective: under 1 % of the rows
     assert summ.set_index("reason").loc["blunder", "rows"] < 0.01 * len(tab)
+
+
+@pytest.mark.realdata
+def test_cassini_and_messenger_ramps_and_range_are_not_edited_as_blunders(shared_data):
+    odf = pytest.importorskip("parsers.odf")
+    cas = odf.read(shared_data / "cassini" / "S18TIGM2006_058_0005X25MV1.ODF")
+    out, _ = edit(cas.table, cas.ramps)
+    blunder = bits(out, Flag.BLUNDER)
+    # the 3-way passes sweep over 55 kHz while DSS-25's ramps arrive one light time later: not blunders
+    assert blunder.sum() < 1e-3 * len(out)
+    assert not blunder[out["observable"].to_numpy() == "range"].any()  # modulo 2^25 RU: left to the fit
+    mes = odf.read(shared_data / "messenger" / "odf07155.odf")
+    out, _ = edit(mes.table, mes.ramps)
+    rng = out[out["observable"] == "range"]
+    assert not (rng["flags"] != 0).any()                 # 30-min range points: passes, not short passes
+    assert rng["pass_id"].nunique() < len(rng) / 5

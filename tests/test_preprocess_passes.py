@@ -39,6 +39,13 @@ def test_passes_break_at_gaps_and_configuration_changes():
     assert sorted(summ["samples"]) == sorted([n[0] + n[1], n[2], n[3], n[4], n[5]])
 
 
+def test_sparse_range_points_form_one_pass():
+    t = np.r_[np.arange(0, 6) * 1800.0, 50000.0 + np.arange(0, 4) * 1800.0]  # 30-min points, then a new pass
+    rng = doppler(t, observable="range", unit="RU", count_time=0.0, tag="receive")
+    out = assign_passes(rng, max_gap=600.0)
+    assert out["pass_id"].tolist() == [0] * 6 + [1] * 4
+
+
 def test_ramp_jump_splits_a_pass_but_a_rate_change_does_not():
     tab = doppler(np.arange(0.5, 600.0), ramped=True, uplink_hz=np.nan)
     start = [T0, T0 + np.timedelta64(200, "s"), T0 + np.timedelta64(400, "s")]

@@ -7,8 +7,9 @@ Editors look only at columns, so they run on any TrackingTable:
 * duplicates: same link and time tag as an earlier row (the first is kept);
 * format validity: ``validity`` != 0 (ODF) or ``valid`` false;
 * blunders: per pass, a gross test on the values and a robust (median/MAD)
-  test on the signal detrended by piecewise polynomials between uplink ramp changes;
-* range ambiguity: range outside [0, modulus) (``range_modulus_ru`` column);
+  test on the signal detrended against each sample's neighbours
+  (:func:`odpipe.preprocess.robust.spikes`);
+* range ambiguity: range outside [0, modulus) (``range_modulus_ru`` or ``range_modulus``);
 * short passes, outside the arc, analyst windows;
 * residual outliers during a fit (:func:`residual_outliers`, called by the filter).
 """
@@ -20,11 +21,9 @@ from dataclasses import dataclass, field
 import numpy as np
 import pandas as pd
 
-from odpipe.preprocess import ramp_segments
 from odpipe.preprocess.flags import Flag, set_flag, summary
 from odpipe.preprocess.passes import LINK, assign_passes
-from odpipe.preprocess.robust import gross, outliers, robust_detrend
-from odpipe.preprocess.timetags import interval_bounds
+from odpipe.preprocess.robust import gross, outliers, spikes
 
 
 @dataclass
@@ -32,16 +31,16 @@ class EditConfig:
     """Editing settings (SI: s, rad)."""
 
     min_elevation: float = np.radians(10.0)
-    blunder_k: float = 8.0          # robust sigmas of the detrended signal
-    gross_k: float = 20.0           # robust sigmas of the pass's values
-    piece: float = 300.0            # s, length of the detrending polynomial pieces
-    degree: int = 5
-    ramp_guard: float = 10.0        # s after a ramp change kept apart (round-trip light time)
+    blunder_k: float = 10.0         # robust sigmas of the spike deviation
+    gross_k: float = 5.0            # 10-90 % spreads of the pass's values
     min_pass_samples: int = 10
     min_pass_duration: float = 0.0  # s
     arc: tuple | None = None        # (start, end) UTC
     windows: list = field(default_factory=list)  # analyst windows: dicts start, end[, station_rx, observable]
     max_gap: float = 600.0          # s, pass break
+
+
+MODULUS_COLUMNS = ("range_modulus_ru", "range_modulus")
 
 
 def _ns(table):
@@ -70,40 +69,44 @@ def invalid(table: pd.DataFrame) -> np.ndarray:
     return bad
 
 
-def blunders(table: pd.DataFrame, ramps: pd.DataFrame | None = None, config: EditConfig = EditConfig(),
-             use: np.ndarray | None = None) -> np.ndarray:
-    """Gross outliers per pass (``pass_id`` must be set). Only rows with ``use`` true are tested."""
+def blunders(table: pd.DataFrame, config: EditConfig | None = None, use: np.ndarray | None = None) -> np.ndarray:
+    """Gross outliers per pass (``pass_id`` must be set); only rows with ``use`` true are tested.
+
+    Ambiguous (modular) range is left to the fit, where it is resolved against the model.
+    """
+    config = config or EditConfig()
     use = np.ones(len(table), dtype=bool) if use is None else np.asarray(use, dtype=bool)
     v = table["value"].to_numpy(dtype=float)
-    use = use & np.isfinite(v)
+    use = use & np.isfinite(v) & np.isnan(range_modulus(table))
     pid = table["pass_id"].to_numpy()
-    start, _ = interval_bounds(_ns(table), table["count_time"].to_numpy(), table["tag"].to_numpy())
-    tx, ramped = table["station_tx"].to_numpy(), table["ramped"].to_numpy()
-    seg = ramp_segments.segment_index(tx, ramped, start, ramps)
-    seg_late = ramp_segments.segment_index(tx, ramped, start - int(config.ramp_guard * 1e9), ramps)
-    stretch = pd.DataFrame({"p": pid, "s": seg, "l": seg_late}).groupby(["p", "s", "l"], sort=False).ngroup().to_numpy()
     bad = use & gross(v, pid, config.gross_k, use)
-    t = (start - start.min()) / 1e9 if len(start) else start
-    _, inlier = robust_detrend(t, v, stretch, use=use & ~bad, piece=config.piece, degree=config.degree,
-                               k=config.blunder_k)
-    return bad | (use & ~bad & ~inlier)
+    return bad | spikes(_ns(table), v, pid, config.blunder_k, use & ~bad)
+
+
+def range_modulus(table: pd.DataFrame) -> np.ndarray:
+    """Each row's range modulus in its unit (ODF ``range_modulus_ru``, TDM ``range_modulus``); NaN if none."""
+    mod = np.full(len(table), np.nan)
+    for col in MODULUS_COLUMNS:
+        if col in table:
+            mod = np.where(np.isnan(mod), table[col].to_numpy(dtype=float), mod)
+    return mod
 
 
 def range_outside_modulus(table: pd.DataFrame) -> np.ndarray:
-    """Range rows outside [0, modulus) where the format gives the modulus (``range_modulus_ru``)."""
-    if "range_modulus_ru" not in table:
-        return np.zeros(len(table), dtype=bool)
-    mod = table["range_modulus_ru"].to_numpy(dtype=float)
+    """Range rows outside [0, modulus) where the format gives the modulus."""
+    mod = range_modulus(table)
     v = table["value"].to_numpy(dtype=float)
     return (table["observable"].to_numpy() == "range") & np.isfinite(mod) & ((v < 0) | (v >= mod))
 
 
 def short_passes(table: pd.DataFrame, min_samples: int, min_duration: float) -> np.ndarray:
-    """Rows of passes with fewer than ``min_samples`` rows or lasting less than ``min_duration`` s."""
+    """Rows of passes lasting less than ``min_duration`` s, and of Doppler passes (count time > 0)
+    with fewer than ``min_samples`` rows (sparse range points are not judged by number)."""
     g = table.groupby("pass_id")["epoch"]
     n = g.transform("size").to_numpy()
     dur = (g.transform("max") - g.transform("min")).dt.total_seconds().to_numpy()
-    return (n < min_samples) | (dur < min_duration)
+    counted = table["count_time"].fillna(0).to_numpy() > 0
+    return (counted & (n < min_samples)) | (dur < min_duration)
 
 
 def outside_arc(table: pd.DataFrame, start, end) -> np.ndarray:
@@ -134,9 +137,12 @@ def residual_outliers(table: pd.DataFrame, residual: np.ndarray, k: float = 5.0,
     return use & outliers(residual, table[by].to_numpy(), k, use)
 
 
-def edit(table: pd.DataFrame, ramps: pd.DataFrame | None = None, config: EditConfig = EditConfig()):
-    """Flag ``table`` with every editor; returns (new table, summary of rows per reason)."""
-    ramps = ramp_segments.store(ramps)
+def edit(table: pd.DataFrame, ramps: pd.DataFrame | None = None, config: EditConfig | None = None):
+    """Flag ``table`` with every editor; returns (new table, summary of rows per reason).
+
+    ``ramps`` serve the pass segmentation when ``pass_id`` is unset.
+    """
+    config = config or EditConfig()
     out = assign_passes(table, ramps, max_gap=config.max_gap) if (table["pass_id"] < 0).any() else table.copy()
     flags = out["flags"].to_numpy(dtype=np.int64)
     flags = set_flag(flags, invalid(out), Flag.INVALID)
@@ -144,7 +150,7 @@ def edit(table: pd.DataFrame, ramps: pd.DataFrame | None = None, config: EditCon
     flags = set_flag(flags, below_elevation(out, config.min_elevation), Flag.ELEVATION)
     flags = set_flag(flags, range_outside_modulus(out), Flag.AMBIGUITY)
     untested = (flags & int(Flag.INVALID | Flag.DUPLICATE | Flag.AMBIGUITY)) != 0
-    flags = set_flag(flags, blunders(out, ramps, config, use=~untested), Flag.BLUNDER)
+    flags = set_flag(flags, blunders(out, config, use=~untested), Flag.BLUNDER)
     flags = set_flag(flags, short_passes(out, config.min_pass_samples, config.min_pass_duration), Flag.SHORT_PASS)
     if config.arc is not None:
         flags = set_flag(flags, outside_arc(out, *config.arc), Flag.OUTSIDE_ARC)

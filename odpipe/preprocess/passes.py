@@ -2,7 +2,8 @@
 
 A link is (station_tx, station_rx, spacecraft, observable, band_up, band_down).
 A new pass starts after a gap longer than ``max_gap`` (s, from the end of one
-count interval to the start of the next), when the count time, the ramped flag or
+count interval to the start of the next) and than ``gap_factor`` times the
+link's median sample spacing (sparse range points are not passes each), when the count time, the ramped flag or
 the (unramped) uplink frequency changes, or at an uplink ramp discontinuity.
 """
 
@@ -35,7 +36,7 @@ def _changed(x: np.ndarray) -> np.ndarray:
 
 
 def assign_passes(table: pd.DataFrame, ramps: pd.DataFrame | None = None, *,
-                  max_gap: float = 600.0, jump_tol_hz: float = 1.0) -> pd.DataFrame:
+                  max_gap: float = 600.0, gap_factor: float = 3.0, jump_tol_hz: float = 1.0) -> pd.DataFrame:
     """A copy of ``table`` with ``pass_id`` set (0..P-1, numbered by link then time)."""
     out = table.copy()
     if len(out) == 0:
@@ -48,9 +49,14 @@ def assign_passes(table: pd.DataFrame, ramps: pd.DataFrame | None = None, *,
                                         ramps, jumps_only=True)
     new = np.zeros(len(out), dtype=bool)
     new[0] = True
-    prev_end = np.maximum.accumulate(end[order])  # end of the latest interval so far (overlaps allowed)
+    # end of the link's latest interval so far (overlapping counts allowed)
+    prev_end = pd.Series(end[order]).groupby(link[order]).cummax().to_numpy()
     gap_s = (start[order][1:] - prev_end[:-1]) / 1e9
-    new[1:] |= gap_s > max_gap
+    step = pd.Series(np.diff(start[order]) / 1e9)
+    same = link[order][1:] == link[order][:-1]
+    spacing = step[same].groupby(link[order][1:][same]).median()  # s, each link's usual sample spacing
+    allowed = np.maximum(max_gap, gap_factor * pd.Series(link[order][1:]).map(spacing).fillna(0).to_numpy())
+    new[1:] |= gap_s > allowed
     for col in (link, out["count_time"].to_numpy(dtype=float), out["ramped"].to_numpy(dtype=bool),
                 out["uplink_hz"].to_numpy(dtype=float), jumps):
         new |= _changed(np.asarray(col)[order])
