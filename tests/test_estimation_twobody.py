@@ -119,3 +119,24 @@ def test_unlogged_maneuver_detected_at_its_epoch():
     r0 = sol0.residuals
     assert detect_maneuvers(r0["time"].to_numpy(),
                             (r0["innovation"] / r0["innovation_sigma"]).to_numpy()) == []
+
+
+def test_station_keeping_burn_designed_minus_estimated_and_late_epoch():
+    """A 0.5 m/s burn logged at 36,030 s fires 15 s late and 6 mm/s off its design:
+    dV and epoch offset are recovered within 3 sigma from a 10 mm/s, 10 s a priori."""
+    true_dv = np.array([0.3, -0.35, 0.2])
+    designed = true_dv - np.array([4e-3, -3e-3, 5e-3])
+    prob, obs, truth = twobody_case(np.random.default_rng(21), stochastic=False,
+                                    maneuvers=((36030.0, tuple(true_dv)),),
+                                    designed=[tuple(designed)], late=[15.0])
+    sol = fit(prob, obs, 0.0, DAY, FitOptions(block=600.0))
+    assert sol.converged
+    row = maneuver_table(prob.registry, sol.x0, sol.P0).iloc[0]
+    print(row.to_dict())
+    assert np.all(np.abs(row["estimated"] - true_dv) < 3 * row["sigma"])
+    assert np.all(np.abs(row["estimated_minus_designed"] - (true_dv - designed))
+                  < 3 * row["sigma"])
+    assert abs(row["epoch_offset"] - 15.0) < 3 * row["epoch_offset_sigma"]
+    assert row["epoch_offset_sigma"] < 2.0                    # from 10 s a priori
+    d = sol.x0 - truth["x0"]
+    assert d @ np.linalg.solve(sol.P0, d) < chi2.ppf(0.999, d.size)

@@ -22,8 +22,9 @@ from .registry import ParameterRegistry
 
 
 def maneuver_table(registry: ParameterRegistry, x: np.ndarray, P: np.ndarray) -> pd.DataFrame:
-    """Per maneuver: designed and estimated dV (m/s), sigma and the Mahalanobis distance
-    of estimated-minus-designed (``x``, ``P``: estimate and covariance in registry order)."""
+    """Per maneuver: designed and estimated dV (m/s), sigma, the Mahalanobis distance of
+    estimated-minus-designed, and the epoch offset (s) with sigma when estimated
+    (NaN otherwise). ``x``, ``P``: estimate and covariance in registry order."""
     rows = []
     owners = dict.fromkeys(p.owner for p in registry.parameters if p.kind == "maneuver")
     for owner in owners:
@@ -32,7 +33,10 @@ def maneuver_table(registry: ParameterRegistry, x: np.ndarray, P: np.ndarray) ->
         designed = registry.apriori[idx]
         d = x[idx] - designed
         Pm = P[np.ix_(idx, idx)]
+        it = registry.indices("maneuver_epoch", owner)
+        dt, sdt = (float(x[it[0]]), float(np.sqrt(P[it[0], it[0]]))) if it.size else (np.nan, np.nan)
         rows.append({"maneuver": owner, "epoch": par.epoch,
+                     "epoch_offset": dt, "epoch_offset_sigma": sdt,
                      "designed": designed, "estimated": x[idx], "sigma": np.sqrt(np.diag(Pm)),
                      "estimated_minus_designed": d,
                      "dv_change_norm": float(np.linalg.norm(d)),

@@ -139,28 +139,40 @@ class TwoBodyProblem:
         self.h = h
         self.i_state = registry.slice("state", "sc")
         self.i_acc = registry.indices("stochastic", "sc")   # three or none
-        self.maneuvers = {}
+        self.maneuvers = {}        # epoch -> (dV indices, epoch-offset index or None)
         for p in registry.parameters:
             if p.kind == "maneuver":
-                self.maneuvers.setdefault(p.epoch, []).append(registry.index(p.name))
+                dt = registry.indices("maneuver_epoch", p.owner)
+                self.maneuvers[p.epoch] = (registry.indices("maneuver", p.owner),
+                                           int(dt[0]) if dt.size else None)
         self.i_bias = np.array([registry.index(f"bias.range.{s}") for s in range(len(self.stations))])
 
     def _start(self, t0, x0):
-        """State right after t0 (maneuver applied) and d(state)/d(dV) columns."""
-        s = x0[self.i_state].copy()
-        dv_idx = self.maneuvers.get(float(t0), [])
-        if dv_idx:
-            s[3:6] += x0[dv_idx]
-        return s, dv_idx
+        """State right after t0 with a maneuver there applied; (state, d state / d params).
 
-    def _registry_sens(self, S, dv_idx, m):
+        A firing delayed by dt (epoch offset) shifts the state at t0 by -dt [dV; 0]
+        to first order (f(x-) - f(x+) times dt, f = [v; a])."""
+        s = x0[self.i_state].copy()
+        J = {}
+        if float(t0) in self.maneuvers:
+            dv_idx, dt_idx = self.maneuvers[float(t0)]
+            dv = x0[dv_idx]
+            dt = x0[dt_idx] if dt_idx is not None else 0.0
+            s[3:6] += dv
+            s[0:3] -= dt * dv
+            J[tuple(dv_idx)] = np.vstack([-dt * np.eye(3), np.eye(3)])
+            if dt_idx is not None:
+                J[(dt_idx,)] = np.concatenate([-dv, np.zeros(3)])[:, None]
+        return s, J
+
+    def _registry_sens(self, S, J, m):
         n = len(self.registry)
         D = np.zeros((m, 6, n))
         D[:, :, self.i_state] = S[:, :, :6]
         if self.i_acc.size:
             D[:, :, self.i_acc] = S[:, :, 6:]
-        if dv_idx:
-            D[:, :, dv_idx] = S[:, :, 3:6]
+        for idx, dsdp in J.items():
+            D[:, :, list(idx)] = S[:, :, :6] @ dsdp
         return D
 
     def _acc(self, x0):
@@ -252,12 +264,16 @@ def simulate_twobody(x0, acc_batches, batch, maneuvers, times, rtol=1e-12):
 
 def twobody_case(rng, days=1.0, dt_obs=120.0, batch=8 * 3600.0, sig_acc=5e-9, tau=86400.0,
                  maneuvers=((10 * 3600.0, (3e-3, -2e-3, 5e-3)),), sig_range=2.0,
-                 sig_rate=1e-4, dx0=(3e4, -2e4, 1e4, 0.3, -0.2, 0.1), stochastic=True):
+                 sig_rate=1e-4, dx0=(3e4, -2e4, 1e4, 0.3, -0.2, 0.1), stochastic=True,
+                 designed=None, late=None):
     """Simulated two-body arc (orbit radius 20,000 km) tracked by three DSN-like stations.
 
-    Returns (problem, observations, truth) where truth holds the epoch vector in
-    registry order and the per-batch accelerations. A priori as ARTEMIS Table 4.1:
-    100 km, 1 m/s, 5e-9 m/s^2 accelerations, 10 mm/s maneuvers, 5 m range biases.
+    maneuvers: (logged epoch, true dV); designed: a priori dV per maneuver (default 0);
+    late: true firing delay (s) per maneuver, which also adds an epoch-offset
+    parameter (sigma 10 s). Returns (problem, observations, truth) where truth holds
+    the epoch vector in registry order and the per-batch accelerations. A priori as
+    ARTEMIS Table 4.1: 100 km, 1 m/s, 5e-9 m/s^2 accelerations, 10 mm/s and 10 s
+    maneuvers, 5 m range biases.
     """
     from .fit import Observations
 
@@ -268,8 +284,10 @@ def twobody_case(rng, days=1.0, dt_obs=120.0, batch=8 * 3600.0, sig_acc=5e-9, ta
     reg.add_state("sc", x_nom, 1e5, 1.0)
     if stochastic:
         reg.add_stochastic_acceleration("sc", sig_acc, tau, batch, axes=("x", "y", "z"))
+    designed = [(0.0, 0.0, 0.0)] * len(maneuvers) if designed is None else designed
     for j, (ep, _) in enumerate(maneuvers):
-        reg.add_maneuver("sc", f"m{j}", ep, sigma_dv=0.01)
+        reg.add_maneuver("sc", f"m{j}", ep, sigma_dv=0.01, designed=designed[j],
+                         sigma_epoch=None if late is None else 10.0)
     for s in range(len(DSN_LIKE)):
         reg.add(f"bias.range.{s}", "bias", 0.0, 5.0, owner=f"dss{s}")
     arc = days * 86400.0
@@ -283,7 +301,9 @@ def twobody_case(rng, days=1.0, dt_obs=120.0, batch=8 * 3600.0, sig_acc=5e-9, ta
             acc[j] = m * acc[j - 1] + rng.normal(size=3) * np.sqrt(q)
     x0 = x_nom + np.asarray(dx0)
     t_grid = np.arange(0.0, arc, dt_obs)
-    X = simulate_twobody(x0, acc, batch, {ep: np.asarray(dv) for ep, dv in maneuvers}, t_grid)
+    fire = [ep + (0.0 if late is None else late[j]) for j, (ep, _) in enumerate(maneuvers)]
+    X = simulate_twobody(x0, acc, batch, {f: np.asarray(dv) for f, (_, dv) in zip(fire, maneuvers)},
+                         t_grid)
     it, st = visible_passes(t_grid, DSN_LIKE, X[:, :3])
     it, st = np.repeat(it, 2), np.repeat(st, 2)
     kind = np.tile([0, 1], it.size // 2)
@@ -301,6 +321,8 @@ def twobody_case(rng, days=1.0, dt_obs=120.0, batch=8 * 3600.0, sig_acc=5e-9, ta
         truth_vec[reg.slice("stochastic", "sc")] = acc[0]
     for j, (_, dv) in enumerate(maneuvers):
         truth_vec[reg.slice("maneuver", f"sc.m{j}")] = dv
+        if late is not None:
+            truth_vec[reg.index(f"sc.m{j}.dt")] = late[j]
     truth_vec[reg.slice("bias")] = bias
     problem = TwoBodyProblem(reg, t, st, kind, DSN_LIKE)
     obs = Observations(t, z, sigma, np.array([f"dss{s}.{'range' if k == 0 else 'rate'}"
