@@ -8,7 +8,7 @@ group is evaluated vectorized. Supported observables and their row fields:
 =================  ==========================================================================
 range              two/three-way range, ``unit`` 'RU', 'm' or 's', tagged at reception; band_up
                    gives the range-unit factor; uplink from the ramp store when ``ramped``,
-                   else ``uplink_hz``; optional columns ``range_modulus`` (RU), ``delay_s``.
+                   else ``uplink_hz``; optional columns ``range_modulus`` or ``range_modulus_ru`` (RU), ``delay_s``.
 doppler_2way/3way  count-averaged Doppler (Hz), interval from ``epoch``/``tag``/``count_time``;
                    M2 = ``transponder_ratio`` or the band pair's; the receiver's own ramp is the
                    reference for ramped three-way rows when the store has that station.
@@ -151,7 +151,7 @@ def _evaluate(key, g, trajectories, setup):
         roles = {"station_tx": ("station", tx, st_tx), "station_rx": ("station", rx, st_rx), "spacecraft": ("sc", sc, traj)}
         if obs == "range":
             ru = range_unit_factor(g["band_up"].to_numpy(object))
-            modulus = g["range_modulus"].to_numpy(float) if "range_modulus" in g.columns else np.nan
+            modulus = _column(g, ("range_modulus", "range_modulus_ru"))
             delay = np.nan_to_num(g["delay_s"].to_numpy(float)) if "delay_s" in g.columns else 0.0
             if unit not in ("RU", "m", "s"):
                 raise _Unsupported(f"range in unit {unit!r}: only RU, m and s are modelled")
@@ -203,6 +203,14 @@ def _evaluate(key, g, trajectories, setup):
             comp.params[f"clock:{name}"] = np.stack([comp.params.pop(f"clock_{who}_{k}") for k in ("a0", "a1", "a2")], 1)
         return comp, roles
     raise _Unsupported(f"observable {obs!r} has no model")
+
+
+def _column(g, names):
+    """The first of ``names`` present in ``g`` as floats (TRK-2-34 and ODF name the range modulus differently), else NaN."""
+    for name in names:
+        if name in g.columns:
+            return g[name].to_numpy(float)
+    return np.full(len(g), np.nan)
 
 
 def _trajectory(trajectories, sc):

@@ -1,6 +1,6 @@
 """Residuals observed - computed, in the observable's unit and along the line of sight.
 
-Range rows with a finite ``range_modulus`` (RU) are wrapped into [-M/2, M/2):
+Range rows with a finite ``range_modulus`` (TRK-2-34) or ``range_modulus_ru`` (ODF), in RU, are wrapped into [-M/2, M/2):
 the ambiguity is resolved to the computed value. The line-of-sight form
 multiplies by :attr:`Evaluation.to_los`: metres of one-way range for range
 types (RU -> m: c / (2 F f_up)), m/s of range-rate for Doppler (Hz -> m/s:
@@ -16,8 +16,9 @@ import pandas as pd
 def residuals(rows: pd.DataFrame, evaluation) -> tuple[np.ndarray, np.ndarray]:
     """(observed - computed in row units, the same along the line of sight in m or m/s)."""
     res = rows["value"].to_numpy(float) - evaluation.value
-    if "range_modulus" in rows.columns:
-        m = rows["range_modulus"].to_numpy(float)
+    col = next((c for c in ("range_modulus", "range_modulus_ru") if c in rows.columns), None)
+    if col is not None:
+        m = rows[col].to_numpy(float)
         wrap = (rows["observable"].to_numpy(object) == "range") & np.isfinite(m) & (m > 0)
         mm = np.where(wrap, m, 1.0)
         res = np.where(wrap, np.mod(res + mm / 2, mm) - mm / 2, res)
