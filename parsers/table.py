@@ -52,20 +52,26 @@ def build(n: int, **columns) -> pd.DataFrame:
     """A TrackingTable of ``n`` rows from arrays/scalars; unset columns get missing values.
 
     Format-specific extra columns may be passed too; they are kept after the
-    contract's columns.
+    contract's columns. Columns are set one by one on an empty frame, which
+    spares pandas a consolidation copy of every column (large tables).
     """
-    out = {}
+    out = pd.DataFrame(index=pd.RangeIndex(n))
     for name, (dt, _) in COLUMNS.items():
-        if name in columns:
-            val = columns.pop(name)
-        else:
-            val = _missing(dt)
-        arr = np.broadcast_to(np.asarray(val), (n,)) if np.ndim(val) == 0 else np.asarray(val)
-        out[name] = pd.Series(arr, dtype=_pandas_dtype(dt)) if dt != "datetime64[ns]" else pd.Series(
-            np.asarray(arr, dtype="datetime64[ns]"))
+        out[name] = _column(columns.pop(name, 0 if name == "flags" else _missing(dt)), dt, n)
     for name, val in columns.items():
-        out[name] = np.broadcast_to(np.asarray(val), (n,)) if np.ndim(val) == 0 else np.asarray(val)
-    return pd.DataFrame(out)
+        out[name] = np.broadcast_to(np.asarray(val), (n,)).copy() if np.ndim(val) == 0 else np.asarray(val)
+    return out
+
+
+def _column(val, dt: str, n: int) -> np.ndarray:
+    arr = np.asarray(val, dtype=_numpy_dtype(dt))
+    if arr.ndim == 0:
+        full = np.empty(n, dtype=arr.dtype)
+        full[:] = arr
+        return full
+    if arr.shape != (n,):
+        raise ValueError(f"column of shape {arr.shape} for a table of {n} rows")
+    return arr
 
 
 def validate(df: pd.DataFrame) -> None:
@@ -82,6 +88,10 @@ def _missing(dt: str):
 
 def _pandas_dtype(dt: str):
     return object if dt == "str" else dt
+
+
+def _numpy_dtype(dt: str):
+    return object if dt == "str" else np.dtype(dt)
 
 
 # Ramp table: one row per uplink ramp segment, travelling beside a TrackingTable.

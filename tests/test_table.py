@@ -9,6 +9,7 @@ def test_build_fills_missing_values():
     table.validate(df)
     assert df["station_tx"].tolist() == ["", ""]
     assert df["record"].tolist() == [-1, -1]
+    assert df["flags"].tolist() == [0, 0]  # rows are used until an editor flags them
     assert np.isnan(df["sigma"]).all()
 
 
