@@ -107,6 +107,10 @@ def test_ramp_change_is_never_crossed():
     assert 90.0 in set(np.round(ends, 6)) and 90.0 in set(np.round(starts, 6))
     # a continuous ramp (rate change only) does not split the pass
     assert out["pass_id"].nunique() == 1
+    # the change reaches the data one round-trip light time later
+    late, _ = compress(tab, 60.0, ramps=ramps, ramp_delay=2.5)
+    starts = (late["epoch"] - T0).dt.total_seconds() - late["count_time"] / 2
+    assert 93.0 in set(np.round(starts, 6)) and 90.0 not in set(np.round(starts, 6))
 
 
 @pytest.mark.parametrize("partial", ["keep", "flag", "drop"])
@@ -158,6 +162,20 @@ def test_accumulated_phase_is_differenced_exactly(observable):
     assert np.allclose(out["count_time"], 60.0)
     assert np.max(np.abs(out["value"].to_numpy() - window_truth(out))) < 1e-6
     assert list(out["source_records"].iloc[1]) == list(range(60, 121))
+
+
+def test_phase_is_never_differenced_across_a_hole():
+    t = np.arange(0.0, 301.0, 1.0)
+    t = t[(t < 100) | (t > 130)]                                    # 31-s hole: lock may have been lost
+    tab = build(len(t), epoch=T0 + (t * 1e9).astype("timedelta64[ns]"), tag="receive",
+                observable="total_phase", value=truth_integral(t), unit="cycles", count_time=0.0,
+                station_rx="DSS-24", source="synthetic", record=np.arange(len(t)), flags=0)
+    out, rep = compress(tab, 60.0)
+    start = (out["epoch"] - T0).dt.total_seconds() - out["count_time"] / 2
+    end = start + out["count_time"]
+    assert not ((start < 100) & (end > 130)).any()
+    assert 99.0 in set(np.round(end, 6)) and 131.0 in set(np.round(start, 6))
+    assert np.max(np.abs(out["value"].to_numpy() - window_truth(out))) < 1e-6
 
 
 def test_doppler_counts_add_up():

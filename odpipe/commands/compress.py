@@ -16,11 +16,14 @@ def add_arguments(parser) -> None:
     parser.add_argument("--partial", choices=("keep", "flag", "drop"), default="keep",
                         help="short windows: keep as shorter counts, flag them, or drop and report")
     parser.add_argument("--max-gap", type=float, default=600.0, help="pass break at gaps longer than this, s")
+    parser.add_argument("--ramp-delay", type=float, default=0.0,
+                        help="s between a ramp change at the transmitter and its effect on the data (round-trip light time)")
 
 
 def run(args) -> int:
     table, ramps = store.read(args.input)
-    out, report = compress(table, args.count_time, ramps=ramps, partial=args.partial, max_gap=args.max_gap)
+    out, report = compress(table, args.count_time, ramps=ramps, partial=args.partial, max_gap=args.max_gap,
+                           ramp_delay=args.ramp_delay)
     store.write(args.output, out, ramps)
     print("\n".join(report.lines()))
     return 0

@@ -10,8 +10,8 @@
   the row becomes ``<observable>_rate`` tagged at the middle of the interval.
   (UTDF counters arrive already differenced into Hz by the UTDF reader.)
 
-Windows never span a gap, an overlap, a pass, an uplink ramp segment or a source
-file. Each segment's windows start at its first sample, so only a segment's last
+Windows never span a gap (phase: a hole over twice the usual spacing), an
+overlap, a pass, an uplink ramp segment or a source file. Each segment's windows start at its first sample, so only a segment's last
 window can be short; ``partial`` says what becomes of it. Edited rows
 (``flags != 0``) and other observables pass through unchanged. Every output row
 says which raw records went into it (``source_records``, ``record_first``,
@@ -70,9 +70,10 @@ def _is_phase(df: pd.DataFrame) -> np.ndarray:
             & (df["flags"].to_numpy() == 0))
 
 
-def _segments(df: pd.DataFrame, start, end, ramps, tol_ns, contiguous: bool):
+def _segments(df: pd.DataFrame, start, end, ramps, tol_ns, contiguous: bool, delay_ns: int):
     """Sort order and segment id (sorted) of runs that windows may not cross."""
-    ramp = ramp_segments.segment_index(df["station_tx"].to_numpy(), df["ramped"].to_numpy(), start, ramps)
+    ramp = ramp_segments.segment_index(df["station_tx"].to_numpy(), df["ramped"].to_numpy(), start - delay_ns,
+                                       ramps)
     src = pd.factorize(df["source"])[0]
     order = np.lexsort((start, ramp, src, df["pass_id"].to_numpy()))
     brk = np.zeros(len(df), dtype=bool)
@@ -102,10 +103,10 @@ def _extra_means(sub: pd.DataFrame, group: np.ndarray, weights: np.ndarray, n_gr
     return out
 
 
-def _compress_averaged(df, ramps, count_ns, tol_ns):
+def _compress_averaged(df, ramps, count_ns, tol_ns, delay_ns):
     epoch = df["epoch"].to_numpy().astype("datetime64[ns]").view(np.int64)
     start, end = interval_bounds(epoch, df["count_time"].to_numpy(), df["tag"].to_numpy())
-    order, seg = _segments(df, start, end, ramps, tol_ns, contiguous=True)
+    order, seg = _segments(df, start, end, ramps, tol_ns, contiguous=True, delay_ns=delay_ns)
     sub = df.iloc[order].reset_index(drop=True)
     s, e = start[order], end[order]
     first_of_seg = np.r_[0, np.flatnonzero(np.diff(seg)) + 1]
@@ -142,11 +143,15 @@ def _compress_averaged(df, ramps, count_ns, tol_ns):
     return out
 
 
-def _compress_phase(df, ramps, count_ns, tol_ns):
+def _compress_phase(df, ramps, count_ns, tol_ns, delay_ns):
     t = df["epoch"].to_numpy().astype("datetime64[ns]").view(np.int64)
-    order, seg = _segments(df, t, t, ramps, tol_ns, contiguous=False)
+    order, seg = _segments(df, t, t, ramps, tol_ns, contiguous=False, delay_ns=delay_ns)
     sub = df.iloc[order].reset_index(drop=True)
     t = t[order]
+    # a hole longer than twice the usual sample spacing may hide a loss of lock: never difference across it
+    step = np.diff(t)
+    usual = pd.Series(step).groupby(seg[1:]).transform("median").to_numpy()
+    seg = np.cumsum(np.r_[True, (seg[1:] != seg[:-1]) | (step > 2 * usual)]) - 1
     phase = sub["value"].to_numpy(dtype=float)
     first_of_seg = np.r_[0, np.flatnonzero(np.diff(seg)) + 1]
     last_of_seg = np.r_[first_of_seg[1:] - 1, len(sub) - 1]
@@ -196,7 +201,7 @@ def _passthrough(df):
 
 
 def compress(table: pd.DataFrame, count_time: float = 60.0, *, ramps: pd.DataFrame | None = None,
-             partial: str = "keep", tol: float = 1e-4, max_gap: float = 600.0):
+             partial: str = "keep", tol: float = 1e-4, max_gap: float = 600.0, ramp_delay: float = 0.0):
     """Compress Doppler in ``table`` to ``count_time`` (s); returns (table, CompressionReport).
 
     ``partial``: a window shorter than ``count_time`` by more than ``tol`` (s) is
@@ -205,21 +210,23 @@ def compress(table: pd.DataFrame, count_time: float = 60.0, *, ramps: pd.DataFra
     assigned first (``max_gap``, s) when ``pass_id`` is unset. Sigma of a
     compressed row is the per-sample scatter (third differences, or the a priori
     sigma when a window has under 4 samples) times sqrt(raw count / new count).
+    The ramp in force for a sample is looked up ``ramp_delay`` s (e.g. the
+    round-trip light time, when known) before its count starts.
     """
     if partial not in ("keep", "flag", "drop"):
         raise ValueError(f"partial must be keep, flag or drop, not {partial!r}")
     ramps = ramp_segments.store(ramps)
     if (table["pass_id"] < 0).any():
-        table = assign_passes(table, ramps, max_gap=max_gap)
-    count_ns, tol_ns = int(round(count_time * 1e9)), int(round(tol * 1e9))
+        table = assign_passes(table, ramps, max_gap=max_gap, ramp_delay=ramp_delay)
+    count_ns, tol_ns, delay_ns = (int(round(x * 1e9)) for x in (count_time, tol, ramp_delay))
     avg, pha = _is_averaged(table), _is_phase(table)
     report = CompressionReport(raw_rows=len(table))
     parts, dropped = [], []
     if avg.any():
-        parts.append(_compress_averaged(table[avg], ramps, count_ns, tol_ns))
+        parts.append(_compress_averaged(table[avg], ramps, count_ns, tol_ns, delay_ns))
         report.averaged_rows = len(parts[-1])
     if pha.any():
-        rows, unused = _compress_phase(table[pha], ramps, count_ns, tol_ns)
+        rows, unused = _compress_phase(table[pha], ramps, count_ns, tol_ns, delay_ns)
         parts.append(rows)
         dropped.append(unused)
         report.phase_rows = len(rows)

@@ -35,9 +35,12 @@ def _changed(x: np.ndarray) -> np.ndarray:
     return out
 
 
-def assign_passes(table: pd.DataFrame, ramps: pd.DataFrame | None = None, *,
-                  max_gap: float = 600.0, gap_factor: float = 3.0, jump_tol_hz: float = 1.0) -> pd.DataFrame:
-    """A copy of ``table`` with ``pass_id`` set (0..P-1, numbered by link then time)."""
+def assign_passes(table: pd.DataFrame, ramps: pd.DataFrame | None = None, *, max_gap: float = 600.0,
+                  gap_factor: float = 3.0, jump_tol_hz: float = 1.0, ramp_delay: float = 0.0) -> pd.DataFrame:
+    """A copy of ``table`` with ``pass_id`` set (0..P-1, numbered by link then time).
+
+    Ramp jumps count ``ramp_delay`` s (e.g. the round-trip light time) after they are transmitted.
+    """
     out = table.copy()
     if len(out) == 0:
         return out
@@ -45,8 +48,9 @@ def assign_passes(table: pd.DataFrame, ramps: pd.DataFrame | None = None, *,
     start, end = interval_bounds(epoch, out["count_time"].to_numpy(), out["tag"].to_numpy())
     link = link_id(out)
     order = np.lexsort((start, link))
-    jumps = ramp_segments.segment_index(out["station_tx"].to_numpy(), out["ramped"].to_numpy(), start,
-                                        ramps, jumps_only=True)
+    jumps = ramp_segments.segment_index(out["station_tx"].to_numpy(), out["ramped"].to_numpy(),
+                                        start - int(round(ramp_delay * 1e9)), ramps, jumps_only=True,
+                                        jump_tol_hz=jump_tol_hz)
     new = np.zeros(len(out), dtype=bool)
     new[0] = True
     # end of the link's latest interval so far (overlapping counts allowed)
