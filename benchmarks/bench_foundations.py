@@ -10,6 +10,7 @@ import time
 import numpy as np
 
 from odpipe.environment.ephemeris import Ephemeris, interp_positions
+from odpipe.environment.solid_tides import solid_earth_tide
 from odpipe.frames.earth import _cip_xys_direct, cip_xys, gcrs_to_itrs, itrs_to_gcrs_state
 from odpipe.frames.moon import moon_pa_to_icrf
 from odpipe.time import utc_to_tdb
@@ -53,6 +54,8 @@ def main():
     timed("Sun + Moon via njit interp_positions (python loop)", lambda: [interp_positions(c, t0, h, x) for x in t])
     timed("Sun + Moon interpolant build (1-day arc)", lambda: eph.interpolant(["sun", "moon"], "earth", t[0], t[-1]))
     timed("Moon PA->ICRF matrices (DE421 librations)", lambda: moon_pa_to_icrf(t))
+    sun, moon = eph.position("sun", "earth", t), eph.position("moon", "earth", t)
+    timed("Solid Earth tide displacement (IERS 2010 steps 1-2)", lambda: solid_earth_tide(r, sun, moon, utc))
 
 
 if __name__ == "__main__":
