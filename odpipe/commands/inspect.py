@@ -10,6 +10,7 @@ from parsers import formats
 from parsers.errors import ParseReport
 from parsers.table import TrackingData
 from odpipe.preprocess import ramp_segments, store
+from odpipe.preprocess.edit import duplicates
 
 NAME = "inspect"
 HELP = "detect a file's format and summarize its contents and anomalies"
@@ -38,9 +39,7 @@ def tracking_summary(data: TrackingData) -> list[str]:
         out.append(f"ramped rows: {int(t['ramped'].sum())}")
         if "validity" in t:
             out.append(f"rows the format marks invalid: {int((t['validity'] != 0).sum())}")
-        dup = t.duplicated(subset=["epoch", "observable", "station_tx", "station_rx", "band_up", "band_down",
-                                   "spacecraft"]).sum()
-        out.append(f"duplicate samples: {int(dup)}")
+        out.append(f"duplicate samples: {int(duplicates(t).sum())}")
     rs = ramp_segments.store(data.ramps)
     if rs is not None:
         per = rs.segments.groupby("station").size()

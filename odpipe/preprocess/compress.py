@@ -195,7 +195,7 @@ def _passthrough(df):
     out["n_samples"] = 1
     out["record_first"] = rec
     out["record_last"] = rec
-    out["source_records"] = [rec[i:i + 1] for i in range(len(rec))]
+    out["source_records"] = list(rec.reshape(-1, 1))
     out["scatter"] = np.nan
     return out
 
