@@ -173,8 +173,10 @@ def solve_path(nodes: Sequence, t_anchor, anchor: str = "receive", t_corr=None,
         bodies = [origin_state(ephemeris, b, origin, tk) for b in shapiro_bodies]
         bpos = np.array([b[:, :3] for b in bodies]).reshape(len(bodies), n, 3)
         bvel = np.array([b[:, 3:] for b in bodies]).reshape(len(bodies), n, 3)
-        sf = nodes[free].state(tk)
-        tau = np.linalg.norm(sk[:, :3] - sf[:, :3], axis=1) / C_LIGHT
+        if known == i0:  # first leg: start from the instantaneous distance
+            tau = np.linalg.norm(sk[:, :3] - nodes[free].state(tk)[:, :3], axis=1) / C_LIGHT
+        else:  # later legs start from the previous leg's light time (off by ~ v tau / c, one Newton step)
+            tau = tau.copy()
         for _ in range(_MAXITER):
             te, ce = _shifted(tk, ck, direction * tau)
             sf = _state_at(nodes[free], te, ce)
