@@ -18,7 +18,7 @@ interval are absorbed in one Householder update.
 
 from __future__ import annotations
 
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 from typing import Protocol
 
 import numpy as np
@@ -26,6 +26,7 @@ import pandas as pd
 
 from .registry import ParameterRegistry
 from .smoother import smooth
+from .solution import Solution, checksum
 from .srif import SRIF
 
 EDIT_INNOVATION = 1  # row rejected by the innovation (pre-fit) k-sigma test
@@ -73,37 +74,6 @@ class FitOptions:
     tol_rms: float = 1e-3
     extra_epochs: tuple = ()
     output_at_measurements: bool = False
-
-
-@dataclass
-class Solution:
-    """Fit result. Arrays on ``grid`` hold absolute parameter values (registry order)."""
-
-    names: list
-    grid: np.ndarray
-    filtered_x: np.ndarray
-    filtered_P: np.ndarray
-    smoothed_x: np.ndarray
-    smoothed_P: np.ndarray
-    smoothed_P_consider: np.ndarray
-    residuals: pd.DataFrame
-    history: list = field(default_factory=list)
-    converged: bool = False
-
-    @property
-    def x0(self) -> np.ndarray:
-        """Smoothed parameter vector at the arc epoch."""
-        return self.smoothed_x[0]
-
-    @property
-    def P0(self) -> np.ndarray:
-        """Its covariance including consider-parameter effects."""
-        return self.smoothed_P_consider[0]
-
-    def parameters(self) -> pd.DataFrame:
-        """Epoch estimate and sigma per parameter."""
-        return pd.DataFrame({"name": self.names, "estimate": self.x0,
-                             "sigma": np.sqrt(np.diag(self.P0))}).set_index("name")
 
 
 def build_grid(registry, t_start, t_end, block, extra=()) -> tuple[np.ndarray, dict]:
@@ -191,7 +161,7 @@ def fit(problem: Problem, obs: Observations, t_start: float, t_end: float,
         history.append({"iteration": it + 1, "postfit_rms": rms,
                         "prefit_rms": float(np.sqrt(np.mean((prefit[ok] / sig_row[ok]) ** 2))),
                         "edited": int((~ok).sum()), "max_correction_sigma": float(corr),
-                        "edit_k": float(kk), "scales": dict(scale)})
+                        "edit_k": float(kk), "scales": {str(g): float(v) for g, v in scale.items()}})
         # relinearize about the smoothed solution
         x_ref0 = x_ref0.copy()
         x_ref0[:n_est] += sm[0].x[:n_est]
@@ -220,4 +190,6 @@ def fit(problem: Problem, obs: Observations, t_start: float, t_end: float,
         smoothed_x=refs_arr + np.array([sm[k].x for k in range(K + 1)]),
         smoothed_P=np.array([sm[k].P for k in range(K + 1)]),
         smoothed_P_consider=np.array([sm[k].P_consider for k in range(K + 1)]),
-        residuals=residuals, history=history, converged=converged)
+        residuals=residuals, history=history, converged=converged,
+        inputs={"observations": checksum(obs.time, obs.value, obs.sigma),
+                "apriori": checksum(apriori, sig0), "n_observations": int(m_obs)})
