@@ -32,9 +32,15 @@ def test_detect_formats_of_real_files(shared_data, tmp_path):
     for rel, name in expect.items():
         if name in formats.available():
             assert formats.detect(shared_data / rel) == name, rel
+
+
+def test_inspect_unknown_and_unreadable_inputs(tmp_path, capsys):
     (tmp_path / "notes.txt").write_text("nothing to see here\n")
     assert formats.detect(tmp_path / "notes.txt") is None
     assert main(["inspect", str(tmp_path / "notes.txt")]) == 0
+    assert "format: not recognised" in capsys.readouterr().out
+    assert main(["inspect", str(tmp_path), str(tmp_path / "absent.odf")]) == 1  # a folder, a missing file
+    assert capsys.readouterr().out.count("error:") == 2
 
 
 @pytest.mark.realdata

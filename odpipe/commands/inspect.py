@@ -81,7 +81,12 @@ def summarize(path) -> list[str]:
 
 
 def run(args) -> int:
+    failed = 0
     for path in args.files:
         print(f"== {path}")
-        print("\n".join(summarize(path)))
-    return 0
+        try:
+            print("\n".join(summarize(path)))
+        except (OSError, ValueError) as exc:  # ParseError is a ValueError
+            failed += 1
+            print(f"error: {exc}")
+    return 1 if failed else 0
