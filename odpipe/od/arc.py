@@ -1,0 +1,203 @@
+"""fit_arc: orbit determination of one spacecraft from a TrackingTable over one arc.
+
+The set-up follows the ARTEMIS practice (Table 4.1 of the thesis): epoch state
+(100 km, 1 m/s), SRP scale (10 %), RTN stochastic accelerations, impulsive
+maneuvers at logged epochs (zero a priori deviation from the design, 10 mm/s
+per axis), DSN per-pass range biases (5 m), data sigmas per observable
+(range 2 m, Doppler 0.1 mm/s), an iterated filter-smoother with k-sigma
+editing and, optionally, data weights rescaled per station and observable by
+their post-fit residual RMS after each iteration.
+
+Rows used: ``flags == 0``, ``spacecraft`` of the arc, an observable with a data
+sigma, last reception (interval end for Doppler) within ``[start, end]`` TDB,
+and computable by the models (otherwise reported with the reason).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+import numpy as np
+import pandas as pd
+
+from odpipe.dynamics.forces import ForceModel, SolarRadiationPressure
+from odpipe.estimation.fit import EDIT_INNOVATION, FitOptions, Observations, Solution, fit
+from odpipe.estimation.maneuvers import maneuver_table
+from odpipe.estimation.registry import GaussMarkov, ParameterRegistry
+from odpipe.measurements import MeasurementSetup
+from odpipe.preprocess.flags import Flag
+from odpipe.preprocess.timetags import interval_bounds
+from odpipe.time import utc_to_tdb
+
+from .problem import TrackingProblem
+
+
+@dataclass(frozen=True)
+class ManeuverPlan:
+    """A logged impulsive maneuver: label, epoch (TDB s), designed ICRF dV (m/s), a priori sigma per axis (m/s)."""
+
+    label: str
+    epoch: float
+    designed: tuple = (0.0, 0.0, 0.0)
+    sigma: float = 0.01
+
+
+@dataclass
+class ArcSetup:
+    """Everything one arc fit needs (SI units; times TDB s past J2000).
+
+    state0: a priori epoch state at ``start`` relative to ``force_model.center``.
+    force_model: dynamics without the estimated maneuvers and stochastic accelerations.
+    srp_scale_sigma: a priori sigma of the SRP scale (None: not estimated).
+    stochastic: RTN Gauss-Markov accelerations (m/s^2; tau 0 = white per batch), or None.
+    data_sigma: observable -> sigma along the line of sight (m or m/s).
+    range_bias_sigma: per pass and receiving station (m; None: no biases; pass_id -1 = one per station).
+    oscillator_sigma: (Hz, Hz/s) of the one-way oscillator bias and drift, when doppler_1way is fitted.
+    edit_k: innovation k-sigma per iteration (last repeats); reweight: ARTEMIS data reweighting.
+    block: filter grid spacing (s); lookback: s of trajectory kept before each segment start.
+    """
+
+    spacecraft: str
+    start: float
+    end: float
+    state0: np.ndarray
+    force_model: ForceModel
+    measurements: MeasurementSetup
+    sigma_position: float = 100e3
+    sigma_velocity: float = 1.0
+    srp_scale_sigma: float | None = 0.1
+    stochastic: GaussMarkov | None = None
+    maneuvers: tuple = ()
+    data_sigma: dict = field(default_factory=lambda: {"range": 2.0, "doppler_2way": 1e-4})
+    range_bias_sigma: float | None = 5.0
+    oscillator_sigma: tuple | None = None
+    edit_k: tuple = (np.inf, 10.0, 5.0)
+    max_iter: int = 10
+    reweight: bool = False
+    block: float = 600.0
+    lookback: float = 120.0
+
+
+@dataclass
+class ArcSolution:
+    """Products of one arc fit.
+
+    epochs (N,) TDB s; states (N, 6) m, m/s and covariances (N, 6, 6): smoothed, on the
+    filter grid (at a maneuver epoch the state before the burn); parameters: name, kind,
+    apriori, estimate, sigma (epoch values; stochastic: first batch); maneuvers: designed vs
+    estimated dV; residuals: one line per row considered (see :func:`fit_arc`).
+    """
+
+    spacecraft: str
+    epochs: np.ndarray
+    states: np.ndarray
+    covariances: np.ndarray
+    parameters: pd.DataFrame
+    maneuvers: pd.DataFrame
+    residuals: pd.DataFrame
+    history: list
+    converged: bool
+    solution: Solution
+    registry: ParameterRegistry
+    problem: TrackingProblem
+
+
+def reception_times(rows: pd.DataFrame) -> np.ndarray:
+    """TDB s of each row's last reception (interval end for count-averaged rows)."""
+    _, end = interval_bounds(rows["epoch"].to_numpy("datetime64[ns]").astype(np.int64),
+                             rows["count_time"].to_numpy(float), rows["tag"].to_numpy(object))
+    return np.asarray(utc_to_tdb(end.astype("datetime64[ns]")), float)
+
+
+def select_rows(table: pd.DataFrame, setup: ArcSetup) -> tuple[pd.DataFrame, np.ndarray]:
+    """Rows of the arc in reception-time order (original index kept) and their TDB times."""
+    sel = ((table["flags"].to_numpy() == 0) & table["observable"].isin(list(setup.data_sigma)).to_numpy()
+           & (table["spacecraft"].astype(str).to_numpy() == setup.spacecraft))
+    rows = table[sel]
+    t = reception_times(rows)
+    inside = (t >= setup.start) & (t <= setup.end)
+    order = np.argsort(t[inside], kind="stable")
+    return rows[inside].iloc[order], t[inside][order]
+
+
+def build_registry(setup: ArcSetup, rows: pd.DataFrame) -> ParameterRegistry:
+    """Estimated parameters of the arc (Table 4.1 structure)."""
+    sc = setup.spacecraft
+    reg = ParameterRegistry()
+    reg.add_state(sc, setup.state0, setup.sigma_position, setup.sigma_velocity)
+    if setup.srp_scale_sigma is not None:
+        srp = setup.force_model.of_type(SolarRadiationPressure)
+        if not srp:
+            raise ValueError("srp_scale_sigma given but the force model has no SRP")
+        reg.add(f"{sc}.srp_scale", "dynamic", srp[0].scale, setup.srp_scale_sigma, owner=sc, model="srp_scale")
+    if setup.stochastic is not None:
+        g = setup.stochastic
+        reg.add_stochastic_acceleration(sc, g.sigma, g.tau, g.batch)
+    for m in setup.maneuvers:
+        reg.add_maneuver(sc, m.label, m.epoch, m.sigma, m.designed)
+    if setup.range_bias_sigma is not None:
+        rng = rows[rows["observable"] == "range"]
+        for st, pid in rng[["station_rx", "pass_id"]].drop_duplicates().itertuples(index=False):
+            info = {"observable": "range", "station": st, "spacecraft": sc}
+            if pid >= 0:
+                info["pass_id"] = pid
+            reg.add(f"bias.range.{st}.pass{pid}", "bias", 0.0, setup.range_bias_sigma, owner=st, **info)
+    if setup.oscillator_sigma is not None and (rows["observable"] == "doppler_1way").any():
+        _, bias, drift, _ = setup.measurements.oscillators[sc]
+        reg.add(f"{sc}.osc_bias", "clock", bias, setup.oscillator_sigma[0], owner=sc, oscillator="bias")
+        reg.add(f"{sc}.osc_drift", "clock", drift, setup.oscillator_sigma[1], owner=sc, oscillator="drift")
+    return reg
+
+
+def fit_arc(table: pd.DataFrame, setup: ArcSetup) -> ArcSolution:
+    """Fit the arc; see :class:`ArcSetup` and :class:`ArcSolution`.
+
+    Residual table columns: row (index in ``table``), epoch, observable, station_rx, pass_id,
+    time (TDB s), prefit/postfit (row units, last iteration), to_los (m or m/s per unit),
+    prefit_los/postfit_los, sigma (row units, after reweighting), flags (Flag.RESIDUAL when
+    edited by the fit), status (why a row could not be computed; such rows are not fitted).
+    """
+    rows, times = select_rows(table, setup)
+    reg = build_registry(setup, rows)
+
+    def problem_for(r, t):
+        return TrackingProblem(reg, r, t, {setup.spacecraft: setup.force_model}, setup.measurements,
+                               setup.start, setup.end, setup.lookback)
+
+    problem = problem_for(rows, times)
+    _, to_los, status = problem.reference(reg.apriori)
+    good = status == ""
+    if not good.all():
+        problem = problem_for(rows[good], times[good])
+    used = rows[good]
+    sig = used["observable"].map(setup.data_sigma).to_numpy(float) / to_los[good]
+    group = (used["observable"] + ":" + used["station_rx"].astype(str)).to_numpy(object)
+    obs = Observations(times[good], used["value"].to_numpy(float), sig, group)
+    options = FitOptions(max_iter=setup.max_iter, block=setup.block, edit_k=tuple(setup.edit_k),
+                         reweight=setup.reweight)
+    sol = fit(problem, obs, setup.start, setup.end, options)
+    return _solution(setup, reg, problem, sol, rows, times, to_los, status)
+
+
+def _solution(setup, reg, problem, sol, rows, times, to_los, status) -> ArcSolution:
+    st = reg.slice("state", setup.spacecraft)
+    good = status == ""
+    res = pd.DataFrame({"row": rows.index.to_numpy(), "epoch": rows["epoch"].to_numpy(),
+                        "observable": rows["observable"].to_numpy(), "station_rx": rows["station_rx"].to_numpy(),
+                        "pass_id": rows["pass_id"].to_numpy(), "time": times, "to_los": to_los,
+                        "status": status})
+    for col in ("prefit", "postfit", "sigma"):
+        res[col] = np.nan
+        res.loc[good, col] = sol.residuals[col].to_numpy()
+    res["prefit_los"] = res["prefit"] * res["to_los"]
+    res["postfit_los"] = res["postfit"] * res["to_los"]
+    res["flags"] = 0
+    edited = np.zeros(len(res), bool)
+    edited[good] = (sol.residuals["flags"].to_numpy() & EDIT_INNOVATION) != 0
+    res.loc[edited, "flags"] = int(Flag.RESIDUAL)
+    est = sol.parameters()
+    params = pd.DataFrame({"name": reg.names, "kind": [p.kind for p in reg.parameters], "apriori": reg.apriori,
+                           "estimate": est["estimate"].to_numpy(), "sigma": est["sigma"].to_numpy()})
+    return ArcSolution(setup.spacecraft, sol.grid, sol.smoothed_x[:, st], sol.smoothed_P_consider[:, st, st],
+                       params, maneuver_table(reg, sol.x0, sol.P0), res, sol.history, sol.converged, sol, reg,
+                       problem)

@@ -1,0 +1,289 @@
+"""TrackingProblem: the estimation ``Problem`` protocol over TrackingTable rows.
+
+Glue between :mod:`odpipe.dynamics` (reference trajectories with STM and
+sensitivities), :mod:`odpipe.measurements` (computed values and event partials)
+and :func:`odpipe.estimation.fit.fit`. Registry entries it understands
+(``owner`` = spacecraft id unless said otherwise; values SI):
+
+==============  =================================================================================
+state           epoch position/velocity (``registry.add_state``), relative to the force model centre
+dynamic         a force-model parameter: ``info['model']`` in ``srp_scale``, ``rho_s[k]``, ``rho_d[k]``
+stochastic      RTN accelerations (``registry.add_stochastic_acceleration``, axes R, T, N), m/s^2
+maneuver        impulsive ICRF dV (``registry.add_maneuver``; owner ``<sc>.<label>``), m/s
+clock           one-way oscillator: ``info['oscillator']`` 'bias' (Hz) or 'drift' (Hz/s); nominal
+                frequency and reference epoch from ``setup.oscillators[sc]``
+bias            measurement bias along the line of sight (m for range, m/s for Doppler) of the rows
+                matching ``info`` keys ``observable``, ``station`` (receiver), ``pass_id``, ``spacecraft``
+station         ITRS offset (m) of station ``owner`` from the catalog, ``info['axis']`` x/y/z (linear)
+media           offset of the media scale from ``setup.media_scale`` (linear, exact)
+==============  =================================================================================
+
+Efficiency and exactness. The arc is cut into segments at the epochs where the
+reference may change (stochastic-batch boundaries, maneuvers); each segment is
+integrated once per relinearization (:class:`.segment.SegmentTrajectory`) and
+all its rows are evaluated in one :func:`~odpipe.measurements.compute` call.
+Over a grid interval ``[t0, t1]`` inside a segment (Phi, S = STM and
+sensitivities from the segment start):
+
+* ``Phi_xx = Phi(t1) Phi(t0)^-1`` and ``Phi_xp = S(t1) - Phi(t1) Phi(t0)^-1 S(t0)``;
+* a row's partials at ``t0``: ``H_x = G_x Phi(t0)^-1``, ``H_p = G_p - H_x S(t0)``, with
+  ``G`` the measurement's event partials already composed with ``Phi(t_event)``.
+
+Both are exact for the linearized flow (no re-integration per interval). A
+segment is reused while the reference handed in agrees bit for bit with it,
+and rebuilt from ``t0`` otherwise, so any caller gets a consistent answer.
+Media: a ``media_m`` column enters the computed value (``setup.media_in_model``),
+which is the same as subtracting it from the observed value. Range rows with a
+``range_modulus`` are wrapped to the computed value.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, replace
+
+import numpy as np
+import pandas as pd
+
+from odpipe.dynamics.forces import EmpiricalRTN, ForceModel, SolarRadiationPressure
+from odpipe.measurements import MeasurementSetup, compute, residuals
+
+from .segment import SegmentTrajectory
+
+_LINEAR = ("bias", "station", "media")
+_REFERENCE = ("dynamic", "stochastic", "maneuver", "clock")
+_SUPPORTED = ("state",) + _LINEAR + _REFERENCE
+
+
+@dataclass
+class _Segment:
+    a: float
+    b: float
+    key: np.ndarray            # registry values the reference was built with (_REFERENCE kinds)
+    trajs: dict                # sc -> SegmentTrajectory
+    pidx: dict                 # sc -> registry index per trajectory parameter
+    lo: int                    # rows [lo, hi) of the problem
+    hi: int
+    value: np.ndarray          # computed (row units), linear terms at zero
+    to_los: np.ndarray
+    status: np.ndarray
+    G_x: dict                  # sc -> (m, 6) d value / d x(a-)
+    G_p: dict                  # sc -> (m, p) d value / d params (trajectory order)
+    H_lin: np.ndarray          # (m, n) registry partials of the linear and clock terms
+
+
+class TrackingProblem:
+    """Problem over ``rows`` (a TrackingTable slice, ordered by ``times``: TDB s, last event of each row).
+
+    force_models: spacecraft id -> :class:`ForceModel` (without the estimated
+    maneuvers and stochastic accelerations: the problem adds them);
+    lookback: s before a segment start covered for light time and count intervals.
+    """
+
+    def __init__(self, registry, rows: pd.DataFrame, times: np.ndarray, force_models: dict,
+                 setup: MeasurementSetup, t_start: float, t_end: float, lookback: float = 120.0,
+                 rtol: float = 1e-12, atol: float = 1e-6):
+        self.registry = registry
+        self.rows = rows.reset_index(drop=True)
+        self.times = np.asarray(times, float)
+        if np.any(np.diff(self.times) < 0):
+            raise ValueError("rows must be ordered by time")
+        self.force_models, self.setup = dict(force_models), setup
+        self.t_start, self.t_end = float(t_start), float(t_end)
+        self.lookback, self.rtol, self.atol = lookback, rtol, atol
+        self.n_propagations = 0
+        self._segments: list[_Segment] = []
+        self._last = (None, None)   # (segment, x1) of the last transition, to skip re-checks
+        params = registry.parameters
+        bad = sorted({p.kind for p in params} - set(_SUPPORTED))
+        if bad:
+            raise ValueError(f"parameter kinds not modelled by TrackingProblem: {bad}")
+        self._key_idx = np.array([i for i, p in enumerate(params) if p.kind in _REFERENCE], int)
+        self._lin_idx = np.array([i for i, p in enumerate(params) if p.kind in _LINEAR], int)
+        self._sc = {sc: self._spacecraft_indices(sc) for sc in self.force_models}
+        self._breaks = self._break_epochs()
+
+    # -- registry layout ------------------------------------------------
+    def _spacecraft_indices(self, sc) -> dict:
+        reg = self.registry
+        params = reg.parameters
+        out = {"state": np.arange(reg.slice("state", sc).start, reg.slice("state", sc).stop)}
+        out["dynamic"] = [(i, p.info["model"]) for i, p in enumerate(params)
+                          if p.kind == "dynamic" and p.owner == sc]
+        stoch = {p.info.get("axis"): i for i, p in enumerate(params)
+                 if p.kind == "stochastic" and p.owner == sc}
+        if stoch and set(stoch) != {"R", "T", "N"}:
+            raise ValueError(f"{sc}: stochastic accelerations must be on axes R, T, N")
+        out["stochastic"] = [stoch[a] for a in "RTN"] if stoch else []
+        man: dict = {}
+        for i, p in enumerate(params):
+            if p.kind == "maneuver" and p.owner.startswith(sc + "."):
+                man.setdefault(float(p.epoch), {})[p.name[-1]] = i
+        out["maneuvers"] = {t: [d[a] for a in "xyz"] for t, d in man.items()}
+        out["oscillator"] = {p.info["oscillator"]: i for i, p in enumerate(params)
+                             if p.kind == "clock" and p.owner == sc}
+        return out
+
+    def _break_epochs(self) -> np.ndarray:
+        pts = [self.t_end]
+        for _, proc in self.registry.stochastic_groups():
+            pts += list(np.arange(self.t_start + proc.batch, self.t_end, proc.batch))
+        for ix in self._sc.values():
+            pts += [t for t in ix["maneuvers"] if self.t_start < t < self.t_end]
+        return np.unique(np.asarray(pts, float))
+
+    # -- segments -------------------------------------------------------
+    def _find(self, t0, x0):
+        for seg in self._segments:
+            if seg.a <= t0 < seg.b:
+                if (seg is self._last[0] and x0 is self._last[1] and t0 > seg.a) or self._agrees(seg, t0, x0):
+                    return seg
+                return None
+        return None
+
+    def _agrees(self, seg, t0, x0) -> bool:
+        if not np.array_equal(x0[self._key_idx], seg.key):
+            return False
+        for sc, traj in seg.trajs.items():
+            ref = traj.x_start if t0 == seg.a else traj.state(t0)[0]
+            if not np.array_equal(x0[self._sc[sc]["state"]], ref):
+                return False
+        return True
+
+    def segment(self, t0: float, x0: np.ndarray) -> _Segment:
+        """The segment holding ``t0`` whose reference passes through ``x0`` (built if needed)."""
+        x0 = np.asarray(x0, float)
+        seg = self._find(t0, x0)
+        return seg if seg is not None else self._build(float(t0), x0)
+
+    def _segment_model(self, sc, x0, a, b) -> tuple[ForceModel, list, list]:
+        fm, ix = self.force_models[sc], self._sc[sc]
+        values = {name: x0[i] for i, name in ix["dynamic"]}
+        comps = []
+        for c in fm.components:
+            if isinstance(c, SolarRadiationPressure) and values:
+                surf = [replace(s, rho_s=values.get(f"rho_s[{k}]", s.rho_s), rho_d=values.get(f"rho_d[{k}]", s.rho_d))
+                        for k, s in enumerate(c.surfaces)]
+                c = replace(c, scale=values.get("srp_scale", c.scale), surfaces=surf)
+            comps.append(c)
+        names = [name for _, name in ix["dynamic"]]
+        idx = [i for i, _ in ix["dynamic"]]
+        if ix["stochastic"]:
+            b0 = sum(len(np.atleast_2d(e.batches)) for e in fm.of_type(EmpiricalRTN))
+            acc = x0[ix["stochastic"]]
+            comps.append(EmpiricalRTN(np.array([[a - self.lookback - 1.0, b + 1.0, *acc]])))
+            names += [f"emp[{b0}].{c}" for c in "RTN"]
+            idx += ix["stochastic"]
+        return replace(fm, components=comps), names, idx
+
+    def _build(self, a, x0) -> _Segment:
+        later = self._breaks[self._breaks > a]
+        b = float(later[0]) if later.size else self.t_end
+        self._segments = [s for s in self._segments if s.b <= a or s.a >= b]
+        trajs, pidx = {}, {}
+        for sc, ix in self._sc.items():
+            fm, names, idx = self._segment_model(sc, x0, a, b)
+            dv_idx = ix["maneuvers"].get(a)
+            dv = x0[dv_idx] if dv_idx is not None else None
+            trajs[sc] = SegmentTrajectory(x0[ix["state"]], a, b, fm, names, dv, self.lookback, self.rtol, self.atol)
+            pidx[sc] = np.array(idx + (dv_idx or []), int)
+            self.n_propagations += 1
+        lo = int(np.searchsorted(self.times, a, "left"))
+        hi = self.times.size if b >= self.t_end else int(np.searchsorted(self.times, b, "left"))
+        seg = _Segment(a, b, x0[self._key_idx].copy(), trajs, pidx, lo, hi, *self._evaluate(lo, hi, trajs, x0))
+        self._segments.append(seg)
+        self._segments.sort(key=lambda s: s.a)
+        return seg
+
+    def _measurement_setup(self, x0) -> MeasurementSetup:
+        osc = dict(self.setup.oscillators)
+        for sc, ix in self._sc.items():
+            if ix["oscillator"]:
+                f0, bias, drift, t_ref = self.setup.oscillators[sc]
+                osc[sc] = (f0, x0[ix["oscillator"]["bias"]] if "bias" in ix["oscillator"] else bias,
+                           x0[ix["oscillator"]["drift"]] if "drift" in ix["oscillator"] else drift, t_ref)
+        return replace(self.setup, oscillators=osc)
+
+    def _evaluate(self, lo, hi, trajs, x0):
+        n, m = len(self.registry), hi - lo
+        rows = self.rows.iloc[lo:hi]
+        G_x, G_p = {}, {}
+        H_lin = np.zeros((m, n))
+        if m == 0:
+            return np.zeros(0), np.zeros(0), np.zeros(0, object), G_x, G_p, H_lin
+        ev = compute(rows, trajs, self._measurement_setup(x0))
+        res, _ = residuals(rows, ev)
+        value = rows["value"].to_numpy(float) - res          # computed, wrapped to the observation
+        for sc in trajs:
+            G_x[sc] = ev.partials.get(f"state:{sc}", np.zeros((m, 6)))
+            G_p[sc] = ev.partials.get(f"dynamic:{sc}", np.zeros((m, len(trajs[sc].param_names))))
+        params = self.registry.parameters
+        for i, p in enumerate(params):
+            if p.kind == "bias":
+                sel = self._bias_rows(p, rows)
+                H_lin[sel, i] = ev.partials.get("bias", np.ones((m, 1)))[sel, 0] / ev.to_los[sel]
+            elif p.kind == "station" and f"station:{p.owner}" in ev.partials:
+                H_lin[:, i] = ev.partials[f"station:{p.owner}"][:, "xyz".index(p.info["axis"])]
+            elif p.kind == "media" and "media_scale" in ev.partials:
+                H_lin[:, i] = ev.partials["media_scale"][:, 0]
+            elif p.kind == "clock" and f"oscillator:{p.owner}" in ev.partials:
+                H_lin[:, i] = ev.partials[f"oscillator:{p.owner}"][:, ("bias", "drift").index(p.info["oscillator"])]
+        return value, ev.to_los, ev.status, G_x, G_p, H_lin
+
+    @staticmethod
+    def _bias_rows(p, rows) -> np.ndarray:
+        sel = np.ones(len(rows), bool)
+        for key, col in (("observable", "observable"), ("station", "station_rx"), ("pass_id", "pass_id"),
+                         ("spacecraft", "spacecraft")):
+            if key in p.info:
+                sel &= rows[col].to_numpy() == p.info[key]
+        return sel
+
+    # -- the Problem protocol -------------------------------------------
+    def predict(self, t0, x0, rows):
+        """Computed values (row units) of rows (positions, all in one segment) and H = d value / d x(t0)."""
+        x0 = np.asarray(x0, float)
+        seg = self.segment(t0, x0)
+        loc = np.asarray(rows) - seg.lo
+        if loc.size and (loc.min() < 0 or loc.max() >= seg.hi - seg.lo):
+            raise ValueError(f"rows outside the segment [{seg.a}, {seg.b}) of t0={t0}")
+        H = seg.H_lin[loc]
+        computed = seg.value[loc] + H[:, self._lin_idx] @ x0[self._lin_idx]
+        for sc, traj in seg.trajs.items():
+            Phi0, S0 = traj.mapping(t0)
+            Hx = np.linalg.solve(Phi0.T, seg.G_x[sc][loc].T).T
+            H[:, self._sc[sc]["state"]] = Hx
+            H[:, seg.pidx[sc]] += seg.G_p[sc][loc] - Hx @ S0
+        return computed, H
+
+    def transition(self, t0, t1, x0):
+        """Reference at t1 (parameters held) and Phi = d x(t1) / d x(t0) over the registry."""
+        x0 = np.asarray(x0, float)
+        seg = self.segment(t0, x0)
+        if t1 > seg.b:
+            raise ValueError(f"interval [{t0}, {t1}] crosses the segment end {seg.b}")
+        x1, Phi = x0.copy(), np.eye(x0.size)
+        for sc, traj in seg.trajs.items():
+            st = self._sc[sc]["state"]
+            Phi0, S0 = traj.mapping(t0)
+            M = np.linalg.solve(Phi0.T, traj.stm(t1)[0].T).T
+            x1[st] = traj.state(t1)[0]
+            Phi[np.ix_(st, st)] = M
+            Phi[np.ix_(st, seg.pidx[sc])] = traj.sensitivity(t1)[0] - M @ S0
+        self._last = (seg, x1)
+        return x1, Phi
+
+    # -- whole-arc reference --------------------------------------------
+    def reference(self, x0) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """(computed, to_los, status) of every row on the reference from ``x0`` at ``t_start``
+        with every parameter held (the fit's first pass when stochastic means are zero)."""
+        n = self.times.size
+        value, to_los, status = np.full(n, np.nan), np.full(n, np.nan), np.full(n, "", object)
+        t, x = self.t_start, np.asarray(x0, float)
+        while t < self.t_end:
+            seg = self.segment(t, x)
+            s = slice(seg.lo, seg.hi)
+            value[s] = seg.value + seg.H_lin[:, self._lin_idx] @ x[self._lin_idx]
+            to_los[s], status[s] = seg.to_los, seg.status
+            x, _ = self.transition(t, seg.b, x)
+            t = seg.b
+        return value, to_los, status

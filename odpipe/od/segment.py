@@ -1,0 +1,96 @@
+"""A reference trajectory over one segment of the arc, with a short look-back.
+
+A segment starts at an epoch ``a`` where the reference may change (arc start,
+stochastic-batch boundary, impulsive maneuver) and ends at the next such epoch
+``b``. It is integrated once, forward from the state ``x(a-)`` (before a
+maneuver at ``a``, whose dV is then added), and backward from ``x(a-)`` over a
+look-back of ``lookback`` s so that the light-time and count-interval events of
+the first rows (which precede their tags) are covered.
+
+It offers the :class:`~odpipe.dynamics.trajectory.Trajectory` interface that
+the measurement models read, with
+
+* ``stm(t) = d x(t) / d x(a-)`` (6x6), on both sides of ``a``;
+* ``sensitivity(t) = d x(t) / d p`` for ``param_names`` = the force model's
+  parameters, then ``dv.x|y|z`` of a maneuver at ``a`` (ICRF m/s): its columns
+  are ``stm(t)[:, 3:6]`` after ``a`` and zero before.
+
+The look-back flies the segment's own parameters: a stochastic acceleration of
+the previous batch acts there as the current one (an error of order
+``da * lookback**2 / 2``, micrometres for 1e-9 m/s^2 over 70 s); everything else is exact.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from odpipe.dynamics.propagator import propagate
+
+DV_NAMES = ["dv.x", "dv.y", "dv.z"]
+
+
+class SegmentTrajectory:
+    """Reference trajectory of one spacecraft over ``[a - lookback, b]`` (TDB s)."""
+
+    def __init__(self, x_start, a, b, force_model, params, dv=None, lookback=120.0,
+                 rtol=1e-12, atol=1e-6):
+        self.center = force_model.center
+        self.t0, self.t1 = float(a), float(b)
+        self.x_start = np.asarray(x_start, float).copy()      # x(a-), m and m/s
+        self.n_dv = 0 if dv is None else 3
+        self.param_names = list(params) + (DV_NAMES if dv is not None else [])
+        self._np = len(params)
+        x_plus = self.x_start.copy()
+        if dv is not None:
+            x_plus[3:6] += dv
+        self._fwd = propagate(x_plus, a, b, force_model, with_stm=True, params=list(params),
+                              rtol=rtol, atol=atol)
+        self._back = propagate(self.x_start, a, a - lookback, force_model, with_stm=True,
+                               params=list(params), rtol=rtol, atol=atol)
+        self.n_eval = self._fwd.n_eval + self._back.n_eval
+
+    def _pieces(self, t):
+        t = np.atleast_1d(np.asarray(t, float))
+        before = t < self.t0
+        return t, before
+
+    def _apply(self, t, fn_back, fn_fwd, shape):
+        t, before = self._pieces(t)
+        out = np.empty((t.size,) + shape)
+        if before.any():
+            out[before] = fn_back(t[before])
+        if (~before).any():
+            out[~before] = fn_fwd(t[~before])
+        return out
+
+    def state(self, t) -> np.ndarray:
+        """Position (m) and velocity (m/s), (N, 6); post-maneuver at ``a``."""
+        return self._apply(t, self._back.state, self._fwd.state, (6,))
+
+    def stm(self, t) -> np.ndarray:
+        """d x(t) / d x(a-), (N, 6, 6)."""
+        return self._apply(t, self._back.stm, self._fwd.stm, (6, 6))
+
+    def sensitivity(self, t) -> np.ndarray:
+        """d x(t) / d params, (N, 6, p) in ``param_names`` order."""
+        p = len(self.param_names)
+
+        def back(tt):
+            out = np.zeros((tt.size, 6, p))
+            out[:, :, :self._np] = self._back.sensitivity(tt)
+            return out
+
+        def fwd(tt):
+            out = np.zeros((tt.size, 6, p))
+            out[:, :, :self._np] = self._fwd.sensitivity(tt)
+            if self.n_dv:
+                out[:, :, self._np:] = self._fwd.stm(tt)[:, :, 3:6]
+            return out
+
+        return self._apply(t, back, fwd, (6, p))
+
+    def mapping(self, t: float) -> tuple[np.ndarray, np.ndarray]:
+        """(Phi, S) at one epoch, taking the state at ``a`` before its maneuver (Phi = I, S = 0)."""
+        if t == self.t0:
+            return np.eye(6), np.zeros((6, len(self.param_names)))
+        return self.stm(t)[0], self.sensitivity(t)[0]
