@@ -181,3 +181,20 @@ def test_cassini_and_messenger_ramps_and_range_are_not_edited_as_blunders(shared
     rng = out[out["observable"] == "range"]
     assert not (rng["flags"] != 0).any()                 # 30-min range points: passes, not short passes
     assert rng["pass_id"].nunique() < len(rng) / 5
+
+
+@pytest.mark.realdata
+def test_utdf_validity_bits_decide(shared_data):
+    utdf = pytest.importorskip("parsers.utdf")
+    from odpipe.preprocess.edit import invalid
+
+    path = shared_data / "utdf" / "LSUTDF_367501_119_2019_044_1555.trk"
+    tab = utdf.read(path).table
+    raw = np.frombuffer(path.read_bytes(), dtype=np.uint8).reshape(-1, 75)
+    byte51 = raw[:, 50]  # data validity: bit 0 range, 1 Doppler, 2 angles (1-based byte 51)
+    bad = invalid(tab)
+    for obs, bit in (("range", 0), ("doppler_2way", 1), ("angle_az", 2), ("angle_el", 2)):
+        rows = tab["observable"] == obs
+        want = (byte51[tab.loc[rows, "record"].to_numpy()] >> bit) & 1 == 0
+        assert np.array_equal(bad[rows.to_numpy()], want), obs
+    assert bad.sum() == 633

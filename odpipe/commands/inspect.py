@@ -10,7 +10,7 @@ from parsers import formats
 from parsers.errors import ParseReport
 from parsers.table import TrackingData
 from odpipe.preprocess import ramp_segments, store
-from odpipe.preprocess.edit import duplicates
+from odpipe.preprocess.edit import duplicates, invalid
 
 NAME = "inspect"
 HELP = "detect a file's format and summarize its contents and anomalies"
@@ -37,8 +37,7 @@ def tracking_summary(data: TrackingData) -> list[str]:
         ct = t.loc[t["count_time"] > 0, "count_time"].value_counts().sort_index()
         out.append("count times (s): " + (", ".join(f"{k:g} x{v}" for k, v in ct.items()) or "none"))
         out.append(f"ramped rows: {int(t['ramped'].sum())}")
-        if "validity" in t:
-            out.append(f"rows the format marks invalid: {int((t['validity'] != 0).sum())}")
+        out.append(f"rows the format marks invalid: {int(invalid(t).sum())}")
         out.append(f"duplicate samples: {int(duplicates(t).sum())}")
     rs = ramp_segments.store(data.ramps)
     if rs is not None:

@@ -60,12 +60,20 @@ def duplicates(table: pd.DataFrame) -> np.ndarray:
 
 
 def invalid(table: pd.DataFrame) -> np.ndarray:
-    """Rows the format marks invalid (``validity`` != 0, or ``valid`` false)."""
+    """Rows the format marks invalid.
+
+    A row's own ``valid`` flag decides where it is given (UTDF: the row's
+    validity bit; its ``validity`` byte is a bit field, not a verdict);
+    elsewhere ``validity`` != 0 (ODF: 0 good, 1 bad).
+    """
     bad = np.zeros(len(table), dtype=bool)
-    if "validity" in table:
-        bad |= table["validity"].to_numpy() != 0
+    given = np.zeros(len(table), dtype=bool)
     if "valid" in table:
-        bad |= ~table["valid"].to_numpy(dtype=bool)
+        v = table["valid"]
+        given = v.notna().to_numpy()
+        bad = given & (v.astype(object) == False).to_numpy()  # noqa: E712 - explicit False only
+    if "validity" in table:
+        bad |= ~given & (table["validity"].fillna(0).to_numpy() != 0)
     return bad
 
 
