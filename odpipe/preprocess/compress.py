@@ -2,8 +2,10 @@
 
 * Count-averaged Doppler (``doppler_*``, ``range_rate``, ``sst_doppler`` with a
   count time): N back-to-back count intervals average, weighted by their count
-  times, to exactly the count-averaged Doppler over their union. Doppler
-  counts in cycles (TRK-2-34 ``doppler_count_*``) add up instead.
+  times, to exactly the count-averaged Doppler over their union (unit Hz or
+  m/s). Doppler counts in cycles (TRK-2-34, TDM ``doppler_count*``) pass
+  through: whether a count is per interval or a running counter is the
+  reader's to state.
 * Accumulated phase (``phase_*``, ``total_phase`` in cycles with no count time,
   e.g. TRK-2-34 carrier and total count phase): the difference of phase at the
   ends of a window over its length is exactly the mean frequency (Hz) over it;
@@ -33,6 +35,7 @@ from odpipe.preprocess.timetags import interval_bounds, tag_epoch
 from parsers.table import COLUMNS
 
 AVERAGED = ("range_rate", "sst_doppler")
+RATE_UNITS = ("Hz", "m/s")
 NEW_COLUMNS = ["n_samples", "record_first", "record_last", "source_records", "scatter"]
 
 
@@ -60,6 +63,7 @@ class CompressionReport:
 def _is_averaged(df: pd.DataFrame) -> np.ndarray:
     obs = df["observable"].astype(str)
     return ((obs.str.startswith("doppler") | obs.isin(AVERAGED)).to_numpy()
+            & df["unit"].isin(RATE_UNITS).to_numpy()
             & (df["count_time"].to_numpy(dtype=float) > 0) & (df["flags"].to_numpy() == 0))
 
 
@@ -121,11 +125,9 @@ def _compress_averaged(df, ramps, count_ns, tol_ns, delay_ns):
     v = sub["value"].to_numpy(dtype=float)
     ref = v[first][grp]  # subtract each window's first value: sums stay precise
     total_ct = np.bincount(grp, weights=ct, minlength=ng)
-    counted = sub["unit"].to_numpy()[first] == "cycles"  # Doppler counts add up; frequencies average
-    mean = v[first] + np.bincount(grp, weights=(v - ref) * ct, minlength=ng) / total_ct
-    value = np.where(counted, np.bincount(grp, weights=v, minlength=ng), mean)
+    value = v[first] + np.bincount(grp, weights=(v - ref) * ct, minlength=ng) / total_ct
     scatter, _ = third_difference_scatter(v, grp, ng)
-    ratio = np.sqrt(ct[first] / total_ct) ** np.where(counted, -1, 1)
+    ratio = np.sqrt(ct[first] / total_ct)
     sigma = np.where(np.isfinite(scatter), scatter, sub["sigma"].to_numpy(dtype=float)[first]) * ratio
     out = sub.iloc[first].reset_index(drop=True)
     out["epoch"] = tag_epoch(s[first], e[last], out["tag"].to_numpy()).view("datetime64[ns]")
