@@ -34,3 +34,20 @@ def test_estimates_at_measurement_times_and_grid_invariance():
     d = (np.diagonal(fine.filtered_P, axis1=1, axis2=2)
          - np.diagonal(fine.smoothed_P_consider, axis1=1, axis2=2))[:, :n]
     assert np.all(d >= -1e-9 * np.diagonal(fine.filtered_P, axis1=1, axis2=2)[:, :n])
+
+
+def test_rows_outside_the_arc_are_flagged_not_used():
+    from odpipe.estimation.fit import OUTSIDE_ARC
+
+    reg, prob, t, sigma, kind = _setup()
+    rng = np.random.default_rng(10)
+    y = np.einsum("mk,mk->m", prob.H_rows, _truth(reg, prob, rng)(t)) + rng.normal(size=t.size) * sigma
+    half = ARC / 2
+    full = fit(prob, Observations(t, y, sigma, kind), 0.0, half, FitOptions(block=BATCH))
+    inside = t <= half
+    cut = fit(prob, Observations(t[inside], y[inside], sigma[inside], kind[inside]), 0.0, half,
+              FitOptions(block=BATCH))
+    flags = full.residuals["flags"].to_numpy()
+    assert np.all((flags[~inside] & OUTSIDE_ARC) > 0) and np.all(flags[inside] == 0)
+    assert full.residuals["postfit"][~inside].isna().all()
+    assert np.allclose(full.x0, cut.x0, rtol=0, atol=1e-9 * np.abs(cut.x0).max())

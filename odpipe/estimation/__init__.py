@@ -10,14 +10,14 @@ iterated filter-smoother fit, maneuver products.
 """
 
 from .batch import BatchSolution, batch_least_squares
-from .fit import EDIT_INNOVATION, FitOptions, Observations, Problem, fit
+from .fit import EDIT_INNOVATION, OUTSIDE_ARC, FitOptions, Observations, Problem, fit
 from .maneuvers import ManeuverFinding, detect_maneuvers, maneuver_table
 from .registry import GaussMarkov, Parameter, ParameterRegistry
 from .smoother import smooth
 from .solution import Solution
 from .srif import SRIF, Gaussian
 
-__all__ = ["BatchSolution", "batch_least_squares", "EDIT_INNOVATION", "FitOptions",
+__all__ = ["BatchSolution", "batch_least_squares", "EDIT_INNOVATION", "OUTSIDE_ARC", "FitOptions",
            "Observations", "Problem", "fit", "ManeuverFinding", "detect_maneuvers",
            "maneuver_table", "GaussMarkov", "Parameter", "ParameterRegistry", "smooth",
            "Solution", "SRIF", "Gaussian"]

@@ -30,6 +30,7 @@ from .solution import Solution, checksum
 from .srif import SRIF
 
 EDIT_INNOVATION = 1  # row rejected by the innovation (pre-fit) k-sigma test
+OUTSIDE_ARC = 2      # row time outside [t_start, t_end]
 
 
 class Problem(Protocol):
@@ -100,74 +101,100 @@ def _edit_k(options, it, prev_rms):
     return options.edit_k[min(it, len(options.edit_k) - 1)]
 
 
+@dataclass
+class _Pass:
+    """One filter-smoother pass about a reference."""
+
+    refs: list          # reference vector at each grid epoch (after any stochastic step)
+    filtered: list      # Gaussian deviations, filter
+    smoothed: dict      # Gaussian deviations, smoother, by grid index
+    blocks: list        # (grid index, rows, H, y) of each measurement block
+    flags: np.ndarray
+    prefit: np.ndarray
+    innovation: np.ndarray
+    innovation_sigma: np.ndarray
+
+
+def _filter_smoother_pass(problem, obs, grid, steps, bounds, x_ref0, p_after, sig_row, edit_k):
+    reg = problem.registry
+    m_obs = obs.time.size
+    flags = np.zeros(m_obs, int)
+    flags[: bounds[0]] |= OUTSIDE_ARC
+    flags[bounds[-1]:] |= OUTSIDE_ARC
+    prefit, innov, innov_sig = (np.full(m_obs, np.nan) for _ in range(3))
+    srif = SRIF.from_apriori(reg.sigma, dx=reg.apriori - x_ref0, n_est=reg.n_estimated)
+    xr = x_ref0.copy()
+    refs, blocks, filt = [], [], []
+    K = grid.size - 1
+    for k in range(K):
+        for j, (idx, (m, q)) in enumerate(steps.get(k, ())):
+            new = p_after.get((k, j), m * xr[idx])
+            srif.process_noise(idx, m, q, offset=m * xr[idx] - new)
+            xr = xr.copy()
+            xr[idx] = new
+        refs.append(xr)
+        srif.mark(k)
+        filt.append(srif.gaussian())
+        rows = np.arange(bounds[k], bounds[k + 1])
+        if rows.size:
+            computed, H = problem.predict(grid[k], xr, rows)
+            y = obs.value[rows] - computed
+            nu, s = srif.innovations(H, y, sig_row[rows], filt[-1])
+            bad = np.abs(nu) > edit_k * s
+            flags[rows[bad]] |= EDIT_INNOVATION
+            prefit[rows], innov[rows], innov_sig[rows] = y, nu, s
+            srif.measurement_update(H[~bad], y[~bad], sig_row[rows][~bad])
+            blocks.append((k, rows, H, y))
+        xr, Phi = problem.transition(grid[k], grid[k + 1], xr)
+        srif.time_update(Phi)
+    refs.append(xr)
+    srif.mark(K)
+    filt.append(srif.gaussian())
+    return _Pass(refs, filt, smooth(srif), blocks, flags, prefit, innov, innov_sig)
+
+
 def fit(problem: Problem, obs: Observations, t_start: float, t_end: float,
         options: FitOptions = FitOptions(), x_ref=None) -> Solution:
-    """Iterated filter-smoother fit of ``obs`` over ``[t_start, t_end]``."""
+    """Iterated filter-smoother fit of ``obs`` over ``[t_start, t_end]`` (TDB s).
+
+    ``x_ref``: initial reference vector (default: the registry's a priori values).
+    Rows outside the arc are flagged ``OUTSIDE_ARC`` and not used.
+    """
     reg = problem.registry
-    n, n_est = len(reg), reg.n_estimated
-    apriori, sig0 = reg.apriori, reg.sigma
-    x_ref0 = apriori.copy() if x_ref is None else np.asarray(x_ref, float).copy()
+    n_est = reg.n_estimated
+    x_ref0 = reg.apriori.copy() if x_ref is None else np.asarray(x_ref, float).copy()
     extra = np.concatenate([np.asarray(options.extra_epochs, float),
                             np.unique(obs.time) if options.output_at_measurements else []])
     grid, steps = build_grid(reg, t_start, t_end, options.block, extra)
-    K = grid.size - 1
     bounds = np.searchsorted(obs.time, grid, side="left")
-    bounds[-1] = obs.time.size
+    bounds[-1] = np.searchsorted(obs.time, t_end, side="right")
     groups = np.unique(obs.group)
     scale = {g: 1.0 for g in groups}
     p_after = {}           # (grid index, group) -> reference stochastic values after the step
     history, prev_rms, converged = [], None, False
-    m_obs = obs.time.size
     for it in range(options.max_iter):
         sig_row = obs.sigma * np.array([scale[g] for g in obs.group])
-        flags = np.zeros(m_obs, int)
-        prefit, innov, innov_sig = (np.full(m_obs, np.nan) for _ in range(3))
-        srif = SRIF.from_apriori(sig0, dx=apriori - x_ref0, n_est=n_est)
-        xr = x_ref0.copy()
-        refs, blocks, filt = [], [], []
         kk = _edit_k(options, it, prev_rms)
-        for k in range(K):
-            for j, (idx, (m, q)) in enumerate(steps.get(k, ())):
-                new = p_after.get((k, j), m * xr[idx])
-                srif.process_noise(idx, m, q, offset=m * xr[idx] - new)
-                xr = xr.copy()
-                xr[idx] = new
-            refs.append(xr)
-            srif.mark(k)
-            filt.append(srif.gaussian())
-            rows = np.arange(bounds[k], bounds[k + 1])
-            if rows.size:
-                computed, H = problem.predict(grid[k], xr, rows)
-                y = obs.value[rows] - computed
-                nu, s = srif.innovations(H, y, sig_row[rows], filt[-1])
-                bad = np.abs(nu) > kk * s
-                flags[rows[bad]] |= EDIT_INNOVATION
-                prefit[rows], innov[rows], innov_sig[rows] = y, nu, s
-                srif.measurement_update(H[~bad], y[~bad], sig_row[rows][~bad])
-                blocks.append((k, rows, H, y))
-            xr, Phi = problem.transition(grid[k], grid[k + 1], xr)
-            srif.time_update(Phi)
-        refs.append(xr)
-        srif.mark(K)
-        filt.append(srif.gaussian())
-        sm = smooth(srif)
-
-        postfit = np.full(m_obs, np.nan)
-        for k, rows, H, y in blocks:
+        ps = _filter_smoother_pass(problem, obs, grid, steps, bounds, x_ref0, p_after,
+                                   sig_row, kk)
+        sm = ps.smoothed
+        postfit = np.full(obs.time.size, np.nan)
+        for k, rows, H, y in ps.blocks:
             postfit[rows] = y - H @ sm[k].x
-        ok = flags == 0
+        ok = ps.flags == 0
         rms = float(np.sqrt(np.mean((postfit[ok] / sig_row[ok]) ** 2)))
         corr = np.max(np.abs(sm[0].x[:n_est]) / np.sqrt(np.diag(sm[0].P)[:n_est]))
         history.append({"iteration": it + 1, "postfit_rms": rms,
-                        "prefit_rms": float(np.sqrt(np.mean((prefit[ok] / sig_row[ok]) ** 2))),
-                        "edited": int((~ok).sum()), "max_correction_sigma": float(corr),
-                        "edit_k": float(kk), "scales": {str(g): float(v) for g, v in scale.items()}})
+                        "prefit_rms": float(np.sqrt(np.mean((ps.prefit[ok] / sig_row[ok]) ** 2))),
+                        "edited": int(np.sum(ps.flags & EDIT_INNOVATION > 0)),
+                        "max_correction_sigma": float(corr), "edit_k": float(kk),
+                        "scales": {str(g): float(v) for g, v in scale.items()}})
         # relinearize about the smoothed solution
         x_ref0 = x_ref0.copy()
         x_ref0[:n_est] += sm[0].x[:n_est]
         for k in steps:
             for j, (idx, _) in enumerate(steps[k]):
-                p_after[(k, j)] = refs[k][idx] + sm[k].x[idx]
+                p_after[(k, j)] = ps.refs[k][idx] + sm[k].x[idx]
         rms_ok = prev_rms is not None and abs(rms - prev_rms) <= options.tol_rms * prev_rms
         prev_rms = rms
         if options.reweight:
@@ -179,17 +206,20 @@ def fit(problem: Problem, obs: Observations, t_start: float, t_end: float,
             converged = True
             break
 
-    refs_arr = np.array(refs)
-    residuals = pd.DataFrame({"time": obs.time, "group": obs.group, "prefit": prefit,
-                              "postfit": postfit, "innovation": innov,
-                              "innovation_sigma": innov_sig, "sigma": sig_row, "flags": flags})
+    refs = np.array(ps.refs)
+    residuals = pd.DataFrame({"time": obs.time, "group": obs.group, "prefit": ps.prefit,
+                              "postfit": postfit, "innovation": ps.innovation,
+                              "innovation_sigma": ps.innovation_sigma, "sigma": sig_row,
+                              "flags": ps.flags})
+    K = grid.size - 1
     return Solution(
         names=reg.names, grid=grid,
-        filtered_x=refs_arr + np.array([filt[k].x for k in range(K + 1)]),
-        filtered_P=np.array([f.P_consider for f in filt]),
-        smoothed_x=refs_arr + np.array([sm[k].x for k in range(K + 1)]),
+        filtered_x=refs + np.array([g.x for g in ps.filtered]),
+        filtered_P=np.array([g.P_consider for g in ps.filtered]),
+        smoothed_x=refs + np.array([sm[k].x for k in range(K + 1)]),
         smoothed_P=np.array([sm[k].P for k in range(K + 1)]),
         smoothed_P_consider=np.array([sm[k].P_consider for k in range(K + 1)]),
         residuals=residuals, history=history, converged=converged,
         inputs={"observations": checksum(obs.time, obs.value, obs.sigma),
-                "apriori": checksum(apriori, sig0), "n_observations": int(m_obs)})
+                "apriori": checksum(reg.apriori, reg.sigma),
+                "n_observations": int(obs.time.size)})
