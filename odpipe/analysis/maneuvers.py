@@ -1,0 +1,43 @@
+"""Maneuver reconstruction: designed against estimated ΔV, as the thesis' Table 4.4.
+
+For each maneuver: the magnitude difference | |ΔV_designed| − |ΔV_estimated| |
+and each component's difference |d_i − e_i|, in mm/s and in percent of the
+designed magnitude or component (NaN where the design is zero), with the estimated magnitude's 1σ from the
+per-axis σ (diagonal only, which the table carries). Over all maneuvers the
+summary gives Average, Median, Max and Min rows. Components are in the frame
+the ΔV were estimated in (ICRF here; the ARTEMIS table used true of date).
+"""
+
+from __future__ import annotations
+
+import numpy as np
+import pandas as pd
+
+COLUMNS = ["Mag. (mm/s)", "Mag. (%)", "X (mm/s)", "X (%)", "Y (mm/s)", "Y (%)", "Z (mm/s)", "Z (%)"]
+
+
+def _nonzero(x: np.ndarray) -> np.ndarray:
+    """x with zeros as NaN: a percentage of a zero design is undefined, not infinite."""
+    return np.where(x > 0, x, np.nan)
+
+
+def evaluate(table: pd.DataFrame) -> tuple[pd.DataFrame, pd.DataFrame]:
+    """(per-maneuver rows, Average/Median/Max/Min summary) from columns ``maneuver``,
+    ``designed``, ``estimated`` (3-vectors, m/s) and ``sigma`` (3-vector, m/s)."""
+    d = np.stack(table["designed"].to_numpy()).astype(float)
+    e = np.stack(table["estimated"].to_numpy()).astype(float)
+    s = np.stack(table["sigma"].to_numpy()).astype(float)
+    dmag, emag = np.linalg.norm(d, axis=1), np.linalg.norm(e, axis=1)
+    unit = e / np.where(emag > 0, emag, 1.0)[:, None]
+    rows = pd.DataFrame({"maneuver": table["maneuver"].to_numpy(),
+                         "designed (mm/s)": dmag * 1e3, "estimated (mm/s)": emag * 1e3,
+                         "estimated sigma (mm/s)": np.sqrt(np.sum((unit * s) ** 2, axis=1)) * 1e3})
+    figures = [np.abs(dmag - emag), np.abs(dmag - emag) / _nonzero(dmag)]
+    for i in range(3):
+        figures += [np.abs(d[:, i] - e[:, i]), np.abs(d[:, i] - e[:, i]) / _nonzero(np.abs(d[:, i]))]
+    for name, values in zip(COLUMNS, figures):
+        rows[name] = values * (1e3 if "mm/s" in name else 100.0)
+    stats = pd.DataFrame({name: [np.nanmean(rows[name]), np.nanmedian(rows[name]), np.nanmax(rows[name]),
+                                 np.nanmin(rows[name])] for name in COLUMNS},
+                         index=["Average", "Median", "Max", "Min"])
+    return rows, stats
