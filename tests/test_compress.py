@@ -178,6 +178,16 @@ def test_phase_is_never_differenced_across_a_hole():
     assert np.max(np.abs(out["value"].to_numpy() - window_truth(out))) < 1e-6
 
 
+def test_format_columns_of_compressed_rows():
+    tab = doppler_table(np.arange(0.5, 120.0, 1.0))
+    tab["elevation"] = np.linspace(0.1, 0.2, len(tab))            # float: averaged over the window
+    tab["item21"] = 100                                             # constant code: kept
+    tab["observable_int"] = np.arange(len(tab))                     # varies: no longer meaningful
+    out, _ = compress(tab, 60.0)
+    assert np.allclose(out["elevation"], [tab["elevation"][:60].mean(), tab["elevation"][60:].mean()])
+    assert list(out["item21"]) == [100, 100] and list(out["observable_int"]) == [-1, -1]
+
+
 def test_doppler_counts_in_cycles_pass_through():
     tab = doppler_table(np.arange(0.5, 120.0, 1.0), observable="doppler_count_2way", unit="cycles")
     out, rep = compress(tab, 60.0)

@@ -95,15 +95,27 @@ def _group_records(records: np.ndarray, group: np.ndarray, n_groups: int) -> lis
     return np.split(records, cuts) if n_groups else []
 
 
-def _extra_means(sub: pd.DataFrame, group: np.ndarray, weights: np.ndarray, n_groups: int) -> dict:
-    """Count-time-weighted means of format-specific numeric columns (others keep the first value)."""
+def _extra_columns(sub: pd.DataFrame, group: np.ndarray, first: np.ndarray, weights: np.ndarray,
+                   n_groups: int) -> dict:
+    """Format-specific columns of the compressed rows.
+
+    Floats (e.g. media corrections, elevation) become count-time-weighted means;
+    integer codes are kept where constant over the window and set to -1 where
+    not (raw parts of the observable, counters); other columns keep the first value.
+    """
     out = {}
     for col in sub.columns:
-        if col in COLUMNS or col in NEW_COLUMNS or sub[col].dtype.kind not in "fiu":
+        if col in COLUMNS or col in NEW_COLUMNS:
             continue
-        x = sub[col].to_numpy(dtype=float)
-        out[col] = np.bincount(group, weights=x * weights, minlength=n_groups) / np.bincount(
-            group, weights=weights, minlength=n_groups)
+        kind = sub[col].dtype.kind
+        if kind == "f":
+            x = sub[col].to_numpy(dtype=float)
+            out[col] = np.bincount(group, weights=x * weights, minlength=n_groups) / np.bincount(
+                group, weights=weights, minlength=n_groups)
+        elif kind in "iu":
+            x = sub[col].to_numpy()
+            same = np.minimum.reduceat(x, first) == np.maximum.reduceat(x, first)
+            out[col] = np.where(same, x[first], -1)
     return out
 
 
@@ -140,8 +152,8 @@ def _compress_averaged(df, ramps, count_ns, tol_ns, delay_ns):
     out["n_samples"] = np.bincount(grp, minlength=ng)
     out["source_records"] = _group_records(records, grp, ng)
     out["scatter"] = scatter
-    for col, mean in _extra_means(sub, grp, ct, ng).items():
-        out[col] = mean
+    for col, x in _extra_columns(sub, grp, first, ct, ng).items():
+        out[col] = x
     return out
 
 
