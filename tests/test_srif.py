@@ -15,18 +15,20 @@ from odpipe.estimation.srif import SRIF
 
 
 def _system(dt=60.0, tau=600.0, sig_a=1e-4):
-    """Phi over one step with the acceleration held constant; state [r(2), v(2), a(2), b]."""
+    """Phi over one step with the acceleration held constant; state [r(2), v(2), a(2), b].
+
+    tau = 0: white noise (m = 0); tau = inf: random walk (m = 1)."""
     Phi = np.eye(7)
     Phi[0:2, 2:4] = dt * np.eye(2)
     Phi[0:2, 4:6] = 0.5 * dt**2 * np.eye(2)
     Phi[2:4, 4:6] = dt * np.eye(2)
-    m = np.exp(-dt / tau)
-    q = sig_a**2 * (1 - m * m)
+    m = 0.0 if tau == 0 else (1.0 if np.isinf(tau) else np.exp(-dt / tau))
+    q = sig_a**2 * (1 - m * m) if 0 < m < 1 else sig_a**2
     return Phi, m, q
 
 
-def _run(rng, K=40, consider=False):
-    Phi, m, q = _system()
+def _run(rng, K=40, tau=600.0):
+    Phi, m, q = _system(tau=tau)
     n = 7
     sig0 = np.array([100.0, 100.0, 1.0, 1.0, 1e-4, 1e-4, 5.0])
     H_all = [np.column_stack([rng.normal(size=(3, 4)), np.zeros((3, 2)), np.ones((3, 1))])
@@ -86,9 +88,10 @@ def _rel(a, b):
     return np.max(np.abs(a - b)) / np.max(np.abs(b))
 
 
-def test_srif_and_sris_match_textbook_kalman_and_rts():
+@pytest.mark.parametrize("tau", [600.0, 0.0, np.inf], ids=["gauss-markov", "white", "random-walk"])
+def test_srif_and_sris_match_textbook_kalman_and_rts(tau):
     rng = np.random.default_rng(1)
-    filt, sm, xf, Pf, xs, Ps = _run(rng)
+    filt, sm, xf, Pf, xs, Ps = _run(rng, tau=tau)
     K = len(xf)
     worst_f = max(max(_rel(filt[k].x, xf[k]), _rel(filt[k].P, Pf[k])) for k in range(K))
     worst_s = max(max(_rel(sm[k].x, xs[k]), _rel(sm[k].P, Ps[k])) for k in range(K))
