@@ -34,6 +34,7 @@ rows that do not involve the group):
 (p, ``traj.param_names``), ``station:<name>`` (3, ITRS m), ``bias`` (1, unit of
 the row), ``delay`` (1, per s of range delay), ``media_scale`` (1),
 ``oscillator:<sc>`` (2: Hz bias, Hz/s drift), ``clock:<sc>`` (3: c*a0, c*a1, c*a2).
+Trajectories without ``stm`` (reference ephemerides) give values but no state groups.
 Rows that cannot be computed get NaN and a reason in :attr:`Evaluation.status`.
 """
 
@@ -268,7 +269,7 @@ def _store(out: Evaluation, idx, n, comp: Computed, roles, g, setup):
     for role, (kind, name, obj) in roles.items():
         if kind == "station":
             _put(out, f"station:{name}", ["x", "y", "z"], idx, n, station_partials(comp, role, obj))
-        elif (name, role) not in done:
+        elif (name, role) not in done and hasattr(obj, "stm"):  # a trajectory without STM gives values only
             done.add((name, role))
             _put(out, f"state:{name}", ["x", "y", "z", "vx", "vy", "vz"], idx, n, epoch_state_partials(comp, role, obj))
             if getattr(obj, "param_names", None):
