@@ -11,6 +11,7 @@ from parsers.errors import ParseReport
 from parsers.table import TrackingData
 from odpipe.preprocess import ramp_segments, store
 from odpipe.preprocess.edit import duplicates, invalid
+from odpipe.preprocess.passes import assign_passes
 
 NAME = "inspect"
 HELP = "detect a file's format and summarize its contents and anomalies"
@@ -37,6 +38,7 @@ def tracking_summary(data: TrackingData) -> list[str]:
         ct = t.loc[t["count_time"] > 0, "count_time"].value_counts().sort_index()
         out.append("count times (s): " + (", ".join(f"{k:g} x{v}" for k, v in ct.items()) or "none"))
         out.append(f"ramped rows: {int(t['ramped'].sum())}")
+        out.append(f"passes: {assign_passes(t, data.ramps)['pass_id'].nunique()}")
         out.append(f"rows the format marks invalid: {int(invalid(t).sum())}")
         out.append(f"duplicate samples: {int(duplicates(t).sum())}")
     rs = ramp_segments.store(data.ramps)
