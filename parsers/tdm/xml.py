@@ -53,6 +53,8 @@ def _tree(data: bytes, path) -> _Node:
         p.Parse(data, True)
     except expat.ExpatError as err:
         raise ParseError(path, f"malformed XML: {expat.errors.messages[err.code]}", line=err.lineno) from None
+    except LookupError as err:  # an XML declaration naming an unknown encoding
+        raise ParseError(path, f"malformed XML: {err}", line=1) from None
     return root[0]
 
 

@@ -124,7 +124,9 @@ def _rows(block: Block) -> list[dict]:
         if n == 0:
             return []
         obs = r["obs"]
-        step = (np.arange(n) * r["obs_cnt_time"].astype(np.float64)[:, None] * 1e9).round().astype("timedelta64[ns]")
+        spacing = r["obs_cnt_time"].astype(np.float64)
+        spacing = np.where(np.isfinite(spacing) & (np.abs(spacing) < 86400.0), spacing, np.nan)
+        step = pd.to_timedelta((np.arange(n) * spacing[:, None]).ravel(), unit="s").to_numpy().reshape(-1, n)
         rep = {k: np.repeat(np.asarray(v), n) if np.ndim(v) else v for k, v in base.items()}
         rep["epoch"] = (base["epoch"][:, None] + step).ravel()
         rep["count_time"] = np.repeat(r["obs_cnt_time"].astype(np.float64), n)

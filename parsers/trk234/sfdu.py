@@ -104,11 +104,30 @@ def split(buf: bytes, path, errors: str = "raise", report: ParseReport | None = 
             continue
         count = _run_length(u8, pos, total, fc in layout.REPEATED)
         recs = np.frombuffer(buf, dtype=layout.dtype(fc, n_obs), count=count, offset=pos)
-        runs.setdefault((fc, n_obs), []).append((recs, np.arange(record, record + count)))
+        runs.setdefault((fc, n_obs), []).append((recs, np.arange(record, record + count), pos + total * np.arange(count)))
         pos += total * count
         record += count
-    return [Block(fc, _stack([r for r, _ in parts], layout.dtype(fc, n_obs)), np.concatenate([i for _, i in parts]))
-            for (fc, n_obs), parts in sorted(runs.items())]
+    blocks = []
+    for (fc, n_obs), parts in sorted(runs.items()):
+        recs = _stack([r for r, _, _ in parts], layout.dtype(fc, n_obs))
+        index = np.concatenate([i for _, i, _ in parts])
+        offsets = np.concatenate([o for _, _, o in parts])
+        ok = _valid_time(recs)
+        for k in np.flatnonzero(~ok):
+            r = recs[k]
+            reason = f"time tag year {r['year']} day {r['doy']} second {r['sec']!r} is not a valid UTC time"
+            handle(ParseError(path, reason, offset=int(offsets[k]), record=int(index[k])), errors, report)
+        if ok.any():
+            blocks.append(Block(fc, recs[ok], index[ok]))
+    return blocks
+
+
+def _valid_time(recs: np.ndarray) -> np.ndarray:
+    """Time tags a reader can trust: years 1958-2200, day 1-366, 0 <= seconds < 86401."""
+    sec = recs["sec"].astype(np.float64)
+    with np.errstate(invalid="ignore"):
+        return ((recs["year"] >= 1958) & (recs["year"] <= 2200) & (recs["doy"] >= 1) & (recs["doy"] <= 366)
+                & (sec >= 0) & (sec < 86401))
 
 
 def _stack(pieces: list[np.ndarray], dt: np.dtype) -> np.ndarray:
