@@ -21,6 +21,12 @@ F_S = 2.1e9
 def test_band_tables_are_moyers_ratios():
     assert TURNAROUND[("S", "S")] == 240 / 221 and TURNAROUND[("X", "X")] == 880 / 749
     assert TURNAROUND[("S", "X")] == 880 / 221 and TURNAROUND[("X", "Ka")] == 3344 / 749
+    assert TURNAROUND[("Ka", "Ka")] == 3360 / 3599
+    # every pair maps a DSN uplink allocation into its downlink allocation (Hz)
+    up = {"S": 2.115e9, "X": 7.16e9, "Ka": 34.35e9}
+    down = {"S": (2.29e9, 2.30e9), "X": (8.40e9, 8.50e9), "Ka": (31.8e9, 32.3e9)}
+    for (u, d), m2 in TURNAROUND.items():
+        assert down[d][0] < m2 * up[u] < down[d][1], (u, d)
     np.testing.assert_allclose(turnaround_ratio(["s", "X", "x"], ["S", "X", "ka"]), [240 / 221, 880 / 749, 3344 / 749])
     np.testing.assert_allclose(range_unit_factor(["S", "X", "Ka"]), [0.5, 221 / 1498, 221 / 7198])
     assert np.isnan(turnaround_ratio(["S"], [""])[0])

@@ -38,5 +38,10 @@ def test_messenger_odf_rows_are_computed_with_their_ramps(shared_data):
     # ramped two-way Doppler uses the store: about 2 M2 f rhodot/c for the Earth-Venus range-rate (~14 km/s)
     two = (rows["observable"] == "doppler_2way").to_numpy() & done
     assert np.all(np.abs(ev.value[two]) > 5e5) and np.all(np.abs(ev.value[two]) < 1.2e6)
+    # one-way X-band Doppler (reference at S-band scale in the ODF, x 880/240): the observed values
+    # (-383 kHz, approaching) and Venus's geometry agree in sign and to ~10 % (MESSENGER moves relative to Venus)
+    one = (rows["observable"] == "doppler_1way").to_numpy() & done
+    ratio = ev.value[one] / rows["value"].to_numpy()[one]
+    assert np.all((ratio > 0.85) & (ratio < 1.15)), ratio
     res, los = residuals(rows, ev)
     assert np.all(np.isfinite(los[done]))

@@ -25,8 +25,11 @@ TURNAROUND = {
     ("X", "S"): 240 / 749,
     ("X", "X"): 880 / 749,
     ("X", "Ka"): 3344 / 749,
-    ("Ka", "Ka"): 3599 / 3344,
+    ("Ka", "Ka"): 3360 / 3599,
 }
+
+# downlink band -> factor from an S-band-scale one-way reference to the downlink (ODF convention)
+ONE_WAY_SCALE = {"S": 1.0, "X": 880 / 240, "Ka": 3344 / 240}
 
 # uplink band -> F (range units per cycle of uplink)
 RANGE_UNIT_FACTOR = {"S": 1 / 2, "X": 221 / (749 * 2), "Ka": 221 / (3599 * 2)}
@@ -37,7 +40,7 @@ def turnaround_ratio(band_up, band_down) -> np.ndarray:
     up = np.atleast_1d(np.asarray(band_up, dtype=object)).astype(str)
     down = np.broadcast_to(np.atleast_1d(np.asarray(band_down, dtype=object)).astype(str), up.shape)
     pairs, inv = np.unique(np.char.add(np.char.add(up, "/"), down), return_inverse=True)
-    table = np.array([TURNAROUND.get(tuple(_norm(b) for b in p.split("/", 1)), np.nan) for p in pairs])
+    table = np.array([TURNAROUND.get(tuple(band_name(b) for b in p.split("/", 1)), np.nan) for p in pairs])
     return table[inv.ravel()]
 
 
@@ -45,9 +48,10 @@ def range_unit_factor(band_up) -> np.ndarray:
     """F per row (RU per uplink cycle); NaN for an unknown band."""
     up = np.atleast_1d(np.asarray(band_up, dtype=object)).astype(str)
     names, inv = np.unique(up, return_inverse=True)
-    return np.array([RANGE_UNIT_FACTOR.get(_norm(u), np.nan) for u in names])[inv.ravel()]
+    return np.array([RANGE_UNIT_FACTOR.get(band_name(u), np.nan) for u in names])[inv.ravel()]
 
 
-def _norm(band) -> str:
+def band_name(band) -> str:
+    """Canonical band name: S, X, Ka (case-insensitive input)."""
     b = str(band).strip()
     return "Ka" if b.upper() == "KA" else b.upper()

@@ -12,7 +12,9 @@ range              two/three-way range, ``unit`` 'RU', 'm' or 's', tagged at rec
 doppler_2way/3way  count-averaged Doppler (Hz), interval from ``epoch``/``tag``/``count_time``;
                    M2 = ``transponder_ratio`` or the band pair's; the receiver's own ramp is the
                    reference for ramped three-way rows when the store has that station.
-doppler_1way       f_ref = ``uplink_hz``; the spacecraft oscillator from ``setup.oscillators``.
+doppler_1way       f_ref = ``uplink_hz`` (ODF rows: times 880/240 for X, 3344/240 for Ka downlinks, as
+                   the ODF gives it at S-band scale); the oscillator from ``setup.oscillators``
+                   (default: nominal f_ref, no bias or drift).
 angle_az/el/x/y    antenna angles at reception (rad).
 range_rate         instantaneous station-spacecraft range-rate at reception (m/s), for studies.
 sst_range          crosslink two-way range (m); ``spacecraft`` = sc1 (transmits and receives,
@@ -49,7 +51,7 @@ import pandas as pd
 from odpipe.preprocess.timetags import interval_bounds
 
 from . import angles, crosslink, dsn, instantaneous
-from .bands import C_LIGHT, range_unit_factor, turnaround_ratio
+from .bands import ONE_WAY_SCALE, band_name, range_unit_factor, turnaround_ratio
 from .computed import Computed, ConstantUplink
 from .lighttime import anchor_from_utc, solve_path
 from .nodes import SpacecraftNode, StationNode
@@ -169,6 +171,8 @@ def _evaluate(key, g, trajectories, setup):
         st_rx = setup.station(rx)
         nodes = [setup.spacecraft(traj, sc), st_rx]
         f_ref = g["uplink_hz"].to_numpy(float)
+        if "odf_data_type" in g.columns:  # ODF gives the one-way reference at S-band scale (parsers.odf)
+            f_ref = f_ref * ONE_WAY_SCALE.get(band_name(g["band_down"].iloc[0]), np.nan)
         f0, bias, drift, t_ref = setup.oscillators.get(sc, (f_ref, 0.0, 0.0, 0.0))
         s, e = interval()
         comp = dsn.one_way_doppler(solve(nodes, s), solve(nodes, e), f_ref, f0, g["count_time"].to_numpy(float),
