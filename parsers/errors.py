@@ -26,6 +26,14 @@ class ParseError(ValueError):
             where.append(f"record {record}")
         super().__init__(f"{', '.join(where)}: {reason}")
 
+    def __reduce__(self):
+        # Rebuilt from its fields, so it survives pickling (Dask workers, copies of DataFrame.attrs).
+        return _rebuild, (self.path, self.reason, self.offset, self.line, self.record)
+
+
+def _rebuild(path, reason, offset, line, record) -> ParseError:
+    return ParseError(path, reason, offset=offset, line=line, record=record)
+
 
 class ParseReport:
     """What a reader in ``errors="report"`` mode skipped: a list of ParseError."""

@@ -180,11 +180,11 @@ def test_phase_is_never_differenced_across_a_hole():
 
 def test_format_columns_of_compressed_rows():
     tab = doppler_table(np.arange(0.5, 120.0, 1.0))
-    tab["elevation"] = np.linspace(0.1, 0.2, len(tab))            # float: averaged over the window
+    tab["elevation_rx"] = np.linspace(0.1, 0.2, len(tab))            # float: averaged over the window
     tab["item21"] = 100                                             # constant code: kept
     tab["observable_int"] = np.arange(len(tab))                     # varies: no longer meaningful
     out, _ = compress(tab, 60.0)
-    assert np.allclose(out["elevation"], [tab["elevation"][:60].mean(), tab["elevation"][60:].mean()])
+    assert np.allclose(out["elevation_rx"], [tab["elevation_rx"][:60].mean(), tab["elevation_rx"][60:].mean()])
     assert list(out["item21"]) == [100, 100] and list(out["observable_int"]) == [-1, -1]
 
 

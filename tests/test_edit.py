@@ -59,10 +59,10 @@ def test_duplicates_invalid_elevation_short_pass_arc_and_windows():
     tab = pd.concat([tab, tab.iloc[[10]]], ignore_index=True)          # row 600 repeats row 10
     tab["validity"] = 0
     tab.loc[20, "validity"] = 1
-    tab["elevation"] = np.radians(np.linspace(5.0, 40.0, len(tab)))     # below 10 deg for the first rows
+    tab["elevation_rx"] = np.radians(np.linspace(5.0, 40.0, len(tab)))     # below 10 deg for the first rows
     late = sine_doppler(n=5, record=np.arange(1000, 1005), epoch=T0 + np.arange(5) * np.timedelta64(1, "s")
                         + np.timedelta64(2, "h"))
-    late["validity"], late["elevation"] = 0, 1.0
+    late["validity"], late["elevation_rx"] = 0, 1.0
     tab = pd.concat([tab, late], ignore_index=True)
     cfg = EditConfig(arc=(T0, T0 + np.timedelta64(590, "s")),
                      windows=[{"start": T0 + np.timedelta64(300, "s"), "end": T0 + np.timedelta64(310, "s"),
@@ -70,7 +70,7 @@ def test_duplicates_invalid_elevation_short_pass_arc_and_windows():
     out, _ = edit(tab, config=cfg)
     assert np.flatnonzero(bits(out, Flag.DUPLICATE)).tolist() == [600]
     assert np.flatnonzero(bits(out, Flag.INVALID)).tolist() == [20]
-    el = np.degrees(tab["elevation"].to_numpy())
+    el = np.degrees(tab["elevation_rx"].to_numpy())
     assert np.array_equal(bits(out, Flag.ELEVATION), el < 10.0)
     assert np.flatnonzero(bits(out, Flag.SHORT_PASS)).tolist() == list(range(601, 606))
     assert bits(out, Flag.OUTSIDE_ARC).sum() == 10 + 5       # tags 590.5..599.5 s and the late pass

@@ -16,3 +16,12 @@ def test_build_fills_missing_values():
 def test_parse_error_names_the_place():
     err = ParseError("x.odf", "bad data type 99", offset=2016, record=7)
     assert str(err) == "x.odf, byte 2016, record 7: bad data type 99"
+
+
+def test_parse_error_survives_pickling():
+    import copy
+    import pickle
+
+    err = ParseError("x.odf", "bad data type 99", offset=2016, record=7)
+    for back in (pickle.loads(pickle.dumps(err)), copy.deepcopy(err)):
+        assert str(back) == str(err) and back.offset == 2016 and back.record == 7

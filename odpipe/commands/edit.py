@@ -16,7 +16,7 @@ def add_arguments(parser) -> None:
     parser.add_argument("-o", "--output", required=True, help="output Parquet")
     d = EditConfig()
     parser.add_argument("--min-elevation", type=float, default=np.degrees(d.min_elevation),
-                        help="elevation mask, deg (needs an 'elevation' column)")
+                        help="elevation mask, deg (needs an 'elevation_rx' column)")
     parser.add_argument("--blunder-k", type=float, default=d.blunder_k, help="robust sigmas of the detrended signal")
     parser.add_argument("--gross-k", type=float, default=d.gross_k, help="robust sigmas of a pass's values")
     parser.add_argument("--min-pass-samples", type=int, default=d.min_pass_samples)

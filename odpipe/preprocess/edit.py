@@ -3,7 +3,7 @@
 Rows are flagged (``flags`` bits, :mod:`odpipe.preprocess.flags`), never dropped.
 Editors look only at columns, so they run on any TrackingTable:
 
-* elevation mask: ``elevation`` column (rad), supplied by station geometry;
+* elevation mask: ``elevation_rx`` column (rad, at the receiver), from :mod:`odpipe.pipeline.geometry`;
 * duplicates: same link and time tag as an earlier row (the first is kept);
 * format validity: ``validity`` != 0 (ODF) or ``valid`` false;
 * blunders: per pass, a gross test on the values and a robust (median/MAD)
@@ -48,10 +48,10 @@ def _ns(table):
 
 
 def below_elevation(table: pd.DataFrame, min_elevation: float) -> np.ndarray:
-    """Rows whose ``elevation`` (rad) is below ``min_elevation``; none if the column is absent."""
-    if "elevation" not in table:
+    """Rows whose ``elevation_rx`` (rad) is below ``min_elevation``; none if the column is absent."""
+    if "elevation_rx" not in table:
         return np.zeros(len(table), dtype=bool)
-    return table["elevation"].to_numpy(dtype=float) < min_elevation
+    return table["elevation_rx"].to_numpy(dtype=float) < min_elevation
 
 
 def duplicates(table: pd.DataFrame) -> np.ndarray:
