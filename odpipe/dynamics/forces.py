@@ -184,7 +184,11 @@ def _default_rotation(body: str) -> Callable:
 
 
 def compile_model(fm: ForceModel, t0: float, t1: float, params: Sequence[str], with_stm: bool):
-    """Arrays the numba right-hand side reads (see :mod:`odpipe.dynamics.rhs`)."""
+    """Arrays the numba right-hand side reads (see :mod:`odpipe.dynamics.rhs`).
+
+    ``model[1][5]`` is the mid-epoch of the segment being integrated; the propagator
+    sets it so empirical batches and burns switch exactly at segment boundaries.
+    """
     lo, hi = min(t0, t1) - 3600.0, max(t0, t1) + 3600.0
     eph = fm.ephemeris
     center = fm.center.lower()
@@ -255,6 +259,6 @@ def compile_model(fm: ForceModel, t0: float, t1: float, params: Sequence[str], w
                        1.0 if b.frame == "rtn" else 0.0] for b in fm.of_type(FiniteBurn)]).reshape(-1, 8)
     pmap = np.array([_param_code(p) for p in params], dtype=np.int64).reshape(-1, 2)
     flags = np.array([1 if fm.of_type(Relativity) else 0, 1 if with_stm else 0, sun_slot], dtype=np.int64)
-    scal = np.array([gm_center, fm.mass, t_start, t_step, gm_body])
+    scal = np.array([gm_center, fm.mass, t_start, t_step, gm_body, 0.5 * (t0 + t1)])
     return (flags, scal, coeffs, pm, C, S, fac, sh_meta, rot_coefs, rot_meta, srp_row, surfaces, occ,
             emp, burns, pmap)

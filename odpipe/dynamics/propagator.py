@@ -55,6 +55,7 @@ def propagate(state0, t0: float, t1: float, force_model: ForceModel, with_stm: b
     n_eval = 0
     t_a = t0
     for t_b in cuts + [t1]:
+        model[1][5] = 0.5 * (t_a + t_b)
         ts, ys, Fs, ne = integrate(model, float(t_a), y, float(t_b), rtol, atol, max_step, 6)
         pieces.append((ts, ys, Fs))
         n_eval += ne

@@ -85,15 +85,16 @@ def acceleration(t, r, v, model, acc, grad_r, grad_v, dadp):
                 dadp[p] += d_rs[idx]
             elif kind == PARAM_RHO_D:
                 dadp[p] += d_rd[idx]
+    t_seg = scal[5]  # mid-epoch of the segment: piecewise-constant terms switch only between segments
     for b in range(emp.shape[0]):
-        if emp[b, 0] <= t < emp[b, 1]:
+        if emp[b, 0] <= t_seg < emp[b, 1]:
             rtn_acceleration(r, v, emp[b, 2:5], acc, grad_r, grad_v)
             axes = rtn_axes(r, v)
             for p in range(pmap.shape[0]):
                 if pmap[p, 0] == PARAM_EMP and pmap[p, 1] // 3 == b:
                     dadp[p] += axes[:, pmap[p, 1] % 3]
     for b in range(burns.shape[0]):
-        if burns[b, 0] <= t < burns[b, 1]:
+        if burns[b, 0] <= t_seg < burns[b, 1]:
             a_thrust = burns[b, 2] / mass * burns[b, 4:7]
             if burns[b, 7] > 0.0:
                 rtn_acceleration(r, v, a_thrust, acc, grad_r, grad_v)
