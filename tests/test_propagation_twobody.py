@@ -120,3 +120,18 @@ def test_several_spacecraft():
     states = tset.states(3000.0)
     np.testing.assert_allclose(states["a"][0], kepler(X0, 3000.0), atol=1e-6)
     np.testing.assert_allclose(states["b"][0], kepler(x1, 3000.0), atol=1e-6)
+
+
+def test_transverse_empirical_acceleration_raises_semi_major_axis():
+    """Gauss's equation on a circular orbit: da/dt = 2 a^1.5 aT / sqrt(GM); radial and normal leave a."""
+    from odpipe.dynamics.forces import EmpiricalRTN
+
+    a0 = 7.0e6
+    x0 = np.array([a0, 0.0, 0.0, 0.0, np.sqrt(GM / a0), 0.0])
+    T, aT = 6 * 5828.5, 1e-6
+    fm = ForceModel("earth", [EmpiricalRTN(np.array([[0.0, T, 0.0, aT, 0.0]]))], central_gm=GM)
+    s = propagate(x0, 0.0, T, fm, with_stm=False).state(T)[0]
+    a1 = 1.0 / (2.0 / np.linalg.norm(s[:3]) - s[3:] @ s[3:] / GM)
+    expected = 2 * a0**1.5 * aT / np.sqrt(GM) * T  # first order in aT
+    assert a1 - a0 == pytest.approx(expected, rel=1e-3)
+    assert abs(s[2]) < 1e-6  # no out-of-plane motion from a transverse thrust
