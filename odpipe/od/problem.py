@@ -144,8 +144,7 @@ class TrackingProblem:
         if not np.array_equal(x0[self._key_idx], seg.key):
             return False
         for sc, traj in seg.trajs.items():
-            ref = traj.x_start if t0 == seg.a else traj.state(t0)[0]
-            if not np.array_equal(x0[self._sc[sc]["state"]], ref):
+            if not np.array_equal(x0[self._sc[sc]["state"]], traj.at(t0)[0]):
                 return False
         return True
 
@@ -249,7 +248,7 @@ class TrackingProblem:
         H = seg.H_lin[loc]
         computed = seg.value[loc] + H[:, self._lin_idx] @ x0[self._lin_idx]
         for sc, traj in seg.trajs.items():
-            Phi0, S0 = traj.mapping(t0)
+            _, Phi0, S0 = traj.at(t0)
             Hx = np.linalg.solve(Phi0.T, seg.G_x[sc][loc].T).T
             H[:, self._sc[sc]["state"]] = Hx
             H[:, seg.pidx[sc]] += seg.G_p[sc][loc] - Hx @ S0
@@ -264,11 +263,12 @@ class TrackingProblem:
         x1, Phi = x0.copy(), np.eye(x0.size)
         for sc, traj in seg.trajs.items():
             st = self._sc[sc]["state"]
-            Phi0, S0 = traj.mapping(t0)
-            M = np.linalg.solve(Phi0.T, traj.stm(t1)[0].T).T
-            x1[st] = traj.state(t1)[0]
+            _, Phi0, S0 = traj.at(t0)
+            x_1, Phi1, S1 = traj.at(t1)
+            M = np.linalg.solve(Phi0.T, Phi1.T).T
+            x1[st] = x_1
             Phi[np.ix_(st, st)] = M
-            Phi[np.ix_(st, seg.pidx[sc])] = traj.sensitivity(t1)[0] - M @ S0
+            Phi[np.ix_(st, seg.pidx[sc])] = S1 - M @ S0
         self._last = (seg, x1)
         return x1, Phi
 

@@ -48,6 +48,7 @@ class SegmentTrajectory:
         self._back = propagate(self.x_start, a, a - lookback, force_model, with_stm=True,
                                params=list(params), rtol=rtol, atol=atol)
         self.n_eval = self._fwd.n_eval + self._back.n_eval
+        self._memo: dict = {}
 
     def _pieces(self, t):
         t = np.atleast_1d(np.asarray(t, float))
@@ -89,8 +90,17 @@ class SegmentTrajectory:
 
         return self._apply(t, back, fwd, (6, p))
 
-    def mapping(self, t: float) -> tuple[np.ndarray, np.ndarray]:
-        """(Phi, S) at one epoch, taking the state at ``a`` before its maneuver (Phi = I, S = 0)."""
-        if t == self.t0:
-            return np.eye(6), np.zeros((6, len(self.param_names)))
-        return self.stm(t)[0], self.sensitivity(t)[0]
+    def at(self, t: float) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """(x, Phi, S) at one epoch, the state at ``a`` taken before its maneuver (Phi = I, S = 0).
+
+        Remembers the last few epochs: the filter asks for each grid epoch twice."""
+        t = float(t)
+        if t not in self._memo:
+            if t == self.t0:
+                val = (self.x_start, np.eye(6), np.zeros((6, len(self.param_names))))
+            else:
+                val = (self.state(t)[0], self.stm(t)[0], self.sensitivity(t)[0])
+            if len(self._memo) > 4:
+                self._memo.pop(next(iter(self._memo)))
+            self._memo[t] = val
+        return self._memo[t]
