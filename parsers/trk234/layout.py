@@ -11,6 +11,8 @@ UTC (year, day of year, seconds of day).
 
 from __future__ import annotations
 
+from functools import lru_cache
+
 import numpy as np
 
 HEADER = """
@@ -227,6 +229,7 @@ def _fields(spec: str, prefix: str = "", taken: set[str] | None = None) -> list[
     return out
 
 
+@lru_cache(maxsize=None)
 def dtype(format_code: int, n_obs: int = 0) -> np.dtype:
     """Packed big-endian dtype of one whole SFDU of ``format_code`` (``n_obs`` groups for 16/17)."""
     fields = _fields(HEADER)
@@ -243,16 +246,19 @@ def dtype(format_code: int, n_obs: int = 0) -> np.dtype:
     return np.dtype(fields)
 
 
+@lru_cache(maxsize=None)
 def secondary_bytes(ddid: str) -> int:
     """Length in bytes of the secondary CHDO value field plus its 4-byte CHDO header."""
     return 4 + np.dtype(_fields(SECONDARY[ddid])).itemsize
 
 
+@lru_cache(maxsize=None)
 def fixed_bytes(format_code: int) -> int:
     """SFDU length in bytes without repeated groups (and without the trailer for 16/17)."""
     return dtype(format_code, 0).itemsize - (TRAILER_BYTES if format_code in REPEATED else 0)
 
 
+@lru_cache(maxsize=None)
 def group_bytes(format_code: int) -> int:
     """Bytes per repeated observation group (0 for fixed-length formats)."""
     return np.dtype(_fields(REPEATED[format_code])).itemsize if format_code in REPEATED else 0

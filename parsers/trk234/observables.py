@@ -44,13 +44,17 @@ def phase_cycles(hi, lo, frac) -> np.ndarray:
             + np.asarray(frac, np.float64) / 4294967296.0)
 
 
+_DSS = np.array([""] + [f"DSS-{i:02d}" for i in range(1, 256)], dtype=object)
+_BAND = np.array([layout.BANDS.get(c, "?") for c in range(256)], dtype=object)
+_NUMBER = np.array([str(i) for i in range(256)], dtype=object)
+
+
 def _dss(ids) -> np.ndarray:
-    ids = np.asarray(ids)
-    return np.where(ids > 0, np.char.add("DSS-", np.char.zfill(ids.astype(str), 2)), "").astype(object)
+    return _DSS[np.asarray(ids)]
 
 
 def _band(codes) -> np.ndarray:
-    return np.array([layout.BANDS.get(int(c), "?") for c in range(256)], dtype=object)[np.asarray(codes)]
+    return _BAND[np.asarray(codes)]
 
 
 _DOPPLER = {1: "1way", 2: "2way", 3: "3way"}
@@ -59,7 +63,7 @@ _DOPPLER = {1: "1way", 2: "2way", 3: "3way"}
 def _common(r: np.ndarray, fc: int) -> dict:
     """Columns every format shares: time tag, spacecraft, stations and bands from the secondary CHDO."""
     names = r.dtype.names
-    cols = {"epoch": utc(r["year"], r["doy"], r["sec"]), "spacecraft": r["scft_id"].astype(str).astype(object)}
+    cols = {"epoch": utc(r["year"], r["doy"], r["sec"]), "spacecraft": _NUMBER[r["scft_id"]]}
     if "ul_dss_id" in names:
         cols["station_tx"] = _dss(r["ul_dss_id"])
     if "dl_dss_id" in names:

@@ -70,14 +70,25 @@ def _check(buf: bytes, pos: int) -> tuple[int, int, int | None, str | None]:
     return total, fc, n_obs, None
 
 
-def _run_length(u8: np.ndarray, pos: int, total: int, repeated: bool) -> int:
+_KEY = np.r_[np.arange(20), np.arange(28, 32)]
+_KEY_REPEATED = np.r_[_KEY, np.arange(188, 190)]
+
+
+def _run_length(buf: bytes, u8: np.ndarray, pos: int, total: int, repeated: bool) -> int:
     """How many SFDUs from ``pos`` on repeat the first one's label, length, format (and count)."""
-    cols = np.r_[np.arange(20), np.arange(28, 32), np.arange(188, 190) if repeated else []].astype(np.int64)
+    cols = _KEY_REPEATED if repeated else _KEY
+    head = buf[pos:pos + 32]
+    count = 1
+    while count < 8:  # short runs (interleaved files) without numpy overhead
+        at = pos + count * total
+        if at + total > len(buf) or buf[at:at + 32] != head or (
+                repeated and buf[at + 188:at + 190] != buf[pos + 188:pos + 190]):
+            return count
+        count += 1
     key = u8[pos + cols]
-    count, step = 1, 16
+    step = 64
     while True:
-        left = (len(u8) - pos) // total - count
-        m = min(step, left)
+        m = min(step, (len(u8) - pos) // total - count)
         if m <= 0:
             return count
         starts = pos + total * np.arange(count, count + m)
@@ -102,7 +113,7 @@ def split(buf: bytes, path, errors: str = "raise", report: ParseReport | None = 
             pos = nxt if nxt > pos else len(buf)
             record += 1
             continue
-        count = _run_length(u8, pos, total, fc in layout.REPEATED)
+        count = _run_length(buf, u8, pos, total, fc in layout.REPEATED)
         recs = np.frombuffer(buf, dtype=layout.dtype(fc, n_obs), count=count, offset=pos)
         runs.setdefault((fc, n_obs), []).append((recs, np.arange(record, record + count), pos + total * np.arange(count)))
         pos += total * count
@@ -117,7 +128,9 @@ def split(buf: bytes, path, errors: str = "raise", report: ParseReport | None = 
             r = recs[k]
             reason = f"time tag year {r['year']} day {r['doy']} second {r['sec']!r} is not a valid UTC time"
             handle(ParseError(path, reason, offset=int(offsets[k]), record=int(index[k])), errors, report)
-        if ok.any():
+        if ok.all():
+            blocks.append(Block(fc, recs, index))
+        elif ok.any():
             blocks.append(Block(fc, recs[ok], index[ok]))
     return blocks
 
@@ -131,13 +144,8 @@ def _valid_time(recs: np.ndarray) -> np.ndarray:
 
 
 def _stack(pieces: list[np.ndarray], dt: np.dtype) -> np.ndarray:
-    """Concatenate record arrays keeping the packed big-endian dtype (np.concatenate would not)."""
-    out = np.empty(sum(len(p) for p in pieces), dtype=dt)
-    at = 0
-    for p in pieces:
-        out[at:at + len(p)] = p
-        at += len(p)
-    return out
+    """Concatenate packed record arrays byte-wise, keeping the big-endian dtype (np.concatenate would not)."""
+    return np.concatenate([p.view(np.uint8) for p in pieces]).view(dt)
 
 
 def join(blocks: list[Block]) -> bytes:
