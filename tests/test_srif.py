@@ -157,3 +157,18 @@ def test_covariance_positive_definite_with_unobservable_bias():
         mins.append(_min_corr_eig(g.P))
         assert g.sigma[7] == pytest.approx(1e-6, rel=1e-3)   # unobservable: a priori kept
     assert min(mins) > 1e-10, min(mins)
+
+
+def test_accumulated_chi2_is_the_least_squares_cost():
+    """Sum of the squared whitened residuals the Householder updates leave behind equals
+    the weighted least-squares cost at the estimate (a priori term included)."""
+    rng = np.random.default_rng(6)
+    H = rng.normal(size=(40, 3))
+    y = H @ np.array([1.0, -2.0, 0.5]) + rng.normal(size=40) * 0.3
+    sig0 = np.array([10.0, 10.0, 10.0])
+    f = SRIF.from_apriori(sig0)
+    for k in range(0, 40, 7):                     # blocks of uneven size
+        f.measurement_update(H[k:k + 7], y[k:k + 7], np.full(len(y[k:k + 7]), 0.3))
+    x = f.gaussian().x
+    cost = np.sum(((y - H @ x) / 0.3) ** 2) + np.sum((x / sig0) ** 2)
+    assert f.chi2 == pytest.approx(cost, rel=1e-10)
