@@ -10,8 +10,9 @@ range              two/three-way range, ``unit`` 'RU', 'm' or 's', tagged at rec
                    gives the range-unit factor; uplink from the ramp store when ``ramped``,
                    else ``uplink_hz``; optional columns ``range_modulus`` or ``range_modulus_ru`` (RU), ``delay_s``.
 doppler_2way/3way  count-averaged Doppler (Hz), interval from ``epoch``/``tag``/``count_time``;
-                   M2 = ``transponder_ratio`` or the band pair's; the receiver's own ramp is the
-                   reference for ramped three-way rows when the store has that station.
+                   M2 = ``transponder_ratio`` or the band pair's. Reference f_R: ramped ODF rows
+                   use the record's ``reference_hz`` (constant); other ramped three-way rows the
+                   receiver's own ramp when the store has it; else the transmitter's uplink.
 doppler_1way       f_ref = ``uplink_hz`` (ODF rows: times 880/240 for X, 3344/240 for Ka downlinks, as
                    the ODF gives it at S-band scale); the oscillator from ``setup.oscillators``
                    (default: nominal f_ref, no bias or drift).
@@ -163,7 +164,9 @@ def _evaluate(key, g, trajectories, setup):
         m2 = np.where(np.isfinite(m2), m2, turnaround_ratio(g["band_up"].to_numpy(object), g["band_down"].to_numpy(object)))
         s, e = interval()
         ref = None
-        if obs == "doppler_3way" and setup.ramps is not None and rx in getattr(setup.ramps, "stations", []) \
+        if "odf_data_type" in g.columns and g["ramped"].to_numpy(bool).all():
+            ref = g["reference_hz"].to_numpy(float)  # ODF ramped Doppler: M2 f_REF - f_received
+        elif obs == "doppler_3way" and setup.ramps is not None and rx in getattr(setup.ramps, "stations", []) \
                 and g["ramped"].to_numpy(bool).all():
             ref = setup.ramps
         return dsn.dsn_doppler(solve(nodes, s), solve(nodes, e), up, tx, s, e, m2, ref, rx), roles

@@ -15,8 +15,11 @@ Conventions, all tested:
   PN range uses the same range unit.
 * **Two/three-way Doppler** (Hz), count interval [t3s, t3e] of Tc s, turnaround M2:
   ``F = (M2/Tc) [integral(f_R, t3s, t3e) - integral(f_T, t1s, t1e)]``,
-  with f_R the receiver's reference (the same ramp as f_T unless a receiver
-  ramp is named). It is **positive when the spacecraft recedes** (the received
+  with f_R the receiver's reference: the same ramp as f_T by default, the
+  receiver's own ramp, or a constant f_REF (ODF ramped data are referenced to
+  the record's reference frequency: their values are M2 f_REF - f_received,
+  checked on MESSENGER and Cassini ODFs where M2 (f_REF - f_T) is ~1 MHz).
+  It is **positive when the spacecraft recedes** (the received
   frequency falls below M2 f). For a constant uplink it reduces to
   ``F = M2 f (rho_e - rho_s) / Tc``. Evaluated as
   ``(M2/Tc)[integral(f_T, t1e, t3e) - integral(f_T, t1s, t3s)]`` (+ the
@@ -75,16 +78,19 @@ def dsn_doppler(sol_s, sol_e, uplink, station_tx, t3s_utc, t3e_utc, m2, referenc
     """Two/three-way count-averaged Doppler (Hz) over [t3s, t3e] (UTC datetime64[ns]).
 
     ``sol_s``/``sol_e``: path solutions anchored at t3s and t3e; ``m2``: turnaround
-    ratio per row; ``reference``: ramp store of the receiver's reference (None:
-    the transmitter's uplink). Parameter: 'bias' (Hz).
+    ratio per row; ``reference``: the receiver's reference f_R, either None (the
+    transmitter's uplink), a ramp store (the receiver's own ramp, ``station_rx``)
+    or constant frequencies per row (Hz; the ODF's reference frequency). Parameter: 'bias' (Hz).
     """
     tc = (np.asarray(t3e_utc, "datetime64[ns]") - np.asarray(t3s_utc, "datetime64[ns]")).astype(np.int64) * 1e-9
     m2 = np.broadcast_to(np.asarray(m2, dtype=float), tc.shape)
     rho_s, rho_e = sol_s.clock_time, sol_e.clock_time
     cycles = uplink.phase(station_tx, t3e_utc, t3e_utc, -rho_e, 0.0) - uplink.phase(station_tx, t3s_utc, t3s_utc,
                                                                                   -rho_s, 0.0)
-    if reference is not None:
-        cycles = cycles + reference.phase(station_rx, t3s_utc, t3e_utc) - uplink.phase(station_tx, t3s_utc, t3e_utc)
+    if reference is not None:  # + integral of (f_R - f_T) over the count interval at the receiver
+        f_r = reference.phase(station_rx, t3s_utc, t3e_utc) if hasattr(reference, "phase") \
+            else np.asarray(reference, dtype=float) * tc
+        cycles = cycles + f_r - uplink.phase(station_tx, t3s_utc, t3e_utc)
     value = m2 / tc * cycles
     f1e = uplink.frequency(station_tx, t3e_utc, -rho_e)
     f1s = uplink.frequency(station_tx, t3s_utc, -rho_s)
