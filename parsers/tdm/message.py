@@ -12,9 +12,10 @@ from dataclasses import dataclass, field
 
 from parsers.errors import ParseError
 from parsers.tdm import keywords as kw
+from parsers.tdm import times
 
 _PATH = re.compile(r"^[1-5](,[1-5])+$")
-_EPOCH = re.compile(r"^\d{4}-(\d{2}-\d{2}|\d{3})T\d{2}:\d{2}:\d{2}(\.\d*)?Z?$")
+_EPOCH = re.compile(times.EPOCH[:-1] + "Z?$")
 
 
 @dataclass

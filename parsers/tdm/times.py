@@ -15,6 +15,8 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 
+EPOCH = r"^\d{4}-(\d{2}-\d{2}|\d{3})T\d{2}:\d{2}:\d{2}(\.\d+)?$"
+
 # Seconds to add to TAI to get each scale.
 _FROM_TAI = {"TAI": 0.0, "GPS": -19.0, "TT": 32.184}
 LEAP_SCALES = set(_FROM_TAI)
@@ -23,10 +25,10 @@ LEAP_SCALES = set(_FROM_TAI)
 def from_text(text: np.ndarray) -> np.ndarray:
     """datetime64[ns] of CCSDS epoch strings; NaT where a string is not an epoch."""
     s = pd.Series(np.asarray(text, dtype=object)).str.strip().str.rstrip("Z")
-    doy = s.str.match(r"^\d{4}-\d{3}T")
-    out = pd.to_datetime(s.where(~doy), format="%Y-%m-%dT%H:%M:%S.%f", errors="coerce").to_numpy("datetime64[ns]")
-    plain = pd.to_datetime(s.where(~doy), format="%Y-%m-%dT%H:%M:%S", errors="coerce").to_numpy("datetime64[ns]")
-    out = np.where(np.isnat(out), plain, out)
+    shape = s.str.match(EPOCH).fillna(False).astype(bool)
+    doy = s.str.match(r"^\d{4}-\d{3}T").fillna(False).astype(bool) & shape
+    calendar = s.where(shape & ~doy)
+    out = pd.to_datetime(calendar, format="ISO8601", errors="coerce").to_numpy("datetime64[ns]")
     if doy.any():
         d = s[doy]
         year = pd.to_numeric(d.str[:4], errors="coerce")
