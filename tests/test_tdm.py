@@ -61,6 +61,7 @@ def test_example4_range_in_range_units_and_ramps(kvn):
     assert set(rng["tag"]) == {"receive"} and set(rng["station_tx"]) == {"DSS-24"}
     assert list(d.ramps["freq_hz"][:2]) == [7180064367.3536, 7180064472.3146]
     assert list(d.ramps["rate_hz_s"][:2]) == [0.59299, 0.59305]
+    assert rng["ramped"].all() and not t[t["keyword"] == "TRANSMIT_FREQ_1"]["ramped"].any()
     assert d.ramps["start"].iloc[0] == _t("2005-07-10T00:31:51")
     assert d.ramps["end"].iloc[0] == d.ramps["start"].iloc[1] and pd.isna(d.ramps["end"].iloc[-1])
 

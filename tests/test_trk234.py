@@ -131,7 +131,7 @@ def test_ramps_follow_ramp_columns_and_pytrk234(data):
 
 def test_read_write_round_trip_is_bit_for_bit(tmp_path, data):
     out = tmp_path / "again.tnf"
-    trk234.write(out, data.meta["blocks"])
+    trk234.write(out, data)
     assert out.read_bytes() == SAMPLE.read_bytes()
     again = trk234.read(out)
     assert again.table.drop(columns="source").equals(data.table.drop(columns="source"))

@@ -8,7 +8,8 @@ the file. Values are SI (see :mod:`parsers.tdm.keywords`). Tags: integrated type
 ``count_time`` = INTEGRATION_INTERVAL; the others follow TIMETAG_REF (default receive).
 Stations: a ``..._n`` keyword belongs to PARTICIPANT_n; other rows go from the first to
 the last participant of PATH (or PATH_1). TRANSMIT_FREQ_n rows (with TRANSMIT_FREQ_RATE_n
-at the same epoch, else rate 0) also make the ramp table.
+at the same epoch, else rate 0) also make the ramp table, and rows transmitted by a
+station that has ramps are marked ``ramped``.
 """
 
 from __future__ import annotations
@@ -90,7 +91,9 @@ def tracking(msg: Message, source: str, path, errors: str, report: ParseReport) 
     df = pd.concat(parts, ignore_index=True) if parts else tt.empty(EXTRA)
     df["source"] = source
     df = df.sort_values(["epoch", "record"], kind="stable").reset_index(drop=True)
-    return df, _ramps(df, msg, source)
+    ramps = _ramps(df, msg, source)
+    df["ramped"] = df["station_tx"].isin(set(ramps["station"])) & ~df["keyword"].str.startswith("TRANSMIT")
+    return df, ramps
 
 
 def _ramps(df: pd.DataFrame, msg: Message, source: str) -> pd.DataFrame:

@@ -7,6 +7,7 @@ import tempfile
 
 import numpy as np
 
+from parsers.table import TrackingData
 from parsers.trk234 import layout
 from parsers.trk234.sfdu import Block, join
 
@@ -46,9 +47,9 @@ def new_block(format_code: int, n: int, n_obs: int = 0, index=None, **fields) ->
     return Block(format_code, r, np.arange(n) if index is None else np.asarray(index, np.int64))
 
 
-def write(path, blocks: list[Block]) -> None:
-    """Write ``blocks`` as one TRK-2-34 file (SFDUs in ``index`` order), atomically."""
-    data = join(blocks)
+def write(path, blocks: list[Block] | TrackingData) -> None:
+    """Write ``blocks`` (or a TrackingData's ``meta["blocks"]``) as one TRK-2-34 file, SFDUs in ``index`` order."""
+    data = join(blocks.meta["blocks"] if isinstance(blocks, TrackingData) else blocks)
     folder = os.path.dirname(os.path.abspath(path))
     fd, tmp = tempfile.mkstemp(dir=folder, prefix=".trk234-")
     try:
