@@ -1,0 +1,105 @@
+"""TrackingProblem's transition and partials against finite differences of fresh integrations.
+
+The problem composes Phi and H from one integration per segment (Phi(t1) Phi(t0)^-1,
+S(t1) - Phi(t1) Phi(t0)^-1 S(t0)); here they are compared, in the middle of a
+segment that starts at a maneuver, with central differences of
+:func:`odpipe.dynamics.propagator.propagate` started at t0 and of a new problem
+whose arc starts at t0.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from odpipe.dynamics.propagator import propagate
+from odpipe.od import ArcSetup, ManeuverPlan, TrackingProblem
+from odpipe.od.arc import build_registry, select_rows
+from test_od_simulate import force_model, measurement_setup, scenario
+
+STEPS = np.array([100.0, 100.0, 100.0, 0.01, 0.01, 0.01])    # m, m/s: well above the integration noise
+
+
+@pytest.fixture(scope="module")
+def case():
+    sc = scenario()
+    setup = ArcSetup("SC", sc["t0"], sc["t1"], sc["x0"], force_model(), measurement_setup(),
+                     maneuvers=(ManeuverPlan("tcm1", sc["t_man"]),), data_sigma={"range": 1.0, "doppler_2way": 1e-4})
+    rows, times = select_rows(sc["table"], setup)
+    reg = build_registry(setup, rows)
+    x = reg.apriori.copy()
+    x[reg.index("SC.srp_scale")] = 1.05
+    x[reg.indices("maneuver")] = [0.03, -0.02, 0.03]
+    prob = TrackingProblem(reg, rows, times, {"SC": force_model()}, setup.measurements, sc["t0"], sc["t1"])
+    x_man, _ = prob.transition(sc["t0"], sc["t_man"], x)
+    ta = sc["t_man"] + 3600.0
+    while np.count_nonzero((times >= ta) & (times < ta + 3600.0)) < 10:
+        ta += 3600.0
+    x_a, _ = prob.transition(sc["t_man"], ta, x_man)
+    return dict(sc=sc, reg=reg, prob=prob, rows=rows, times=times, x_man=x_man, ta=ta, x_a=x_a, setup=setup)
+
+
+def _flow(x_state, t0, t1, scale):
+    return propagate(x_state, t0, t1, force_model(scale), with_stm=False).state(t1)[0]
+
+
+def _normalized_error(an, fd):
+    return np.max(np.abs(an - fd)) / np.max(np.abs(fd))
+
+
+def test_transition_mid_segment_matches_reintegration(case):
+    reg, prob, ta, x_a = case["reg"], case["prob"], case["ta"], case["x_a"]
+    st, i_srp, i_dv = slice(0, 6), reg.index("SC.srp_scale"), reg.indices("maneuver")
+    t1 = ta + 3600.0
+    x1, Phi = prob.transition(ta, t1, x_a)
+    np.testing.assert_allclose(x1[:6], _flow(x_a[:6], ta, t1, 1.05), rtol=0, atol=1e-3)   # integrator tolerance: rtol 1e-12 of 2.6e8 m
+    for j in range(6):
+        d = np.zeros(6)
+        d[j] = STEPS[j]
+        fd = (_flow(x_a[:6] + d, ta, t1, 1.05) - _flow(x_a[:6] - d, ta, t1, 1.05)) / (2 * STEPS[j])
+        assert _normalized_error(Phi[st, j], fd) < 1e-6, j
+    fd = (_flow(x_a[:6], ta, t1, 1.55) - _flow(x_a[:6], ta, t1, 0.55)) / 1.0   # big step: SRP is linear in it
+    assert _normalized_error(Phi[st, i_srp], fd) < 1e-5
+    # the burn is behind: x(ta) already holds it (zero up to rounding of S(t1) - M S(ta))
+    assert np.max(np.abs(Phi[st][:, i_dv])) < 1e-9 * np.max(np.abs(Phi[st, 3:6]))
+    assert prob.n_propagations == 2             # one integration per segment served every call
+
+
+def test_transition_from_the_burn_epoch_carries_the_dv_partials(case):
+    sc, reg, prob, x_man = case["sc"], case["reg"], case["prob"], case["x_man"]
+    t_man, i_dv = sc["t_man"], reg.indices("maneuver")
+    t1 = t_man + 7200.0
+    _, Phi = prob.transition(t_man, t1, x_man)
+    for k, j in enumerate(i_dv):
+        d = np.zeros(6)
+        d[3 + k] = 1e-3
+        x_plus = x_man[:6].copy()
+        x_plus[3:] += x_man[i_dv]
+        fd = (_flow(x_plus + d, t_man, t1, 1.05) - _flow(x_plus - d, t_man, t1, 1.05)) / 2e-3
+        assert _normalized_error(Phi[:6, j], fd) < 1e-6
+
+
+def test_predict_partials_mid_segment_match_a_problem_started_there(case):
+    reg, prob, ta, x_a = case["reg"], case["prob"], case["ta"], case["x_a"]
+    times = case["times"]
+    sel = np.flatnonzero((times >= ta) & (times < ta + 3600.0))
+    computed, H = prob.predict(ta, x_a, sel)
+    sub = case["rows"].iloc[sel]
+
+    def values(x):
+        fresh = TrackingProblem(reg, sub, times[sel], {"SC": force_model()}, case["setup"].measurements,
+                                ta, ta + 3600.0)
+        return fresh.predict(ta, x, np.arange(sel.size))[0]
+
+    # the same values from a second integration: equal to within integration noise (1 % of the data sigma)
+    assert np.max(np.abs(values(x_a) - computed) / sub["sigma"].to_numpy()) < 0.01
+    cols = list(range(6)) + [reg.index("SC.srp_scale")]
+    steps = list(STEPS) + [0.5]
+    tols = [1e-5] * 6 + [2e-4]     # SRP: the Doppler partials (1e-5 Hz) sit at the integration-noise floor of the FD
+    for j, h, tol in zip(cols, steps, tols):
+        xp, xm = x_a.copy(), x_a.copy()
+        xp[j] += h
+        xm[j] -= h
+        fd = (values(xp) - values(xm)) / (2 * h)
+        assert _normalized_error(H[:, j], fd) < tol, reg.names[j]
+    assert np.max(np.abs(H[:, reg.indices("maneuver")])) < 1e-9 * np.max(np.abs(H[:, 3:6]))
