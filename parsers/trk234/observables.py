@@ -142,16 +142,26 @@ def _rows(block: Block) -> list[dict]:
     return []
 
 
+def _missing_like(values, n: int) -> np.ndarray:
+    kind = np.asarray(values).dtype.kind
+    fill = {"f": np.nan, "i": -1, "u": -1, "b": False, "M": np.datetime64("NaT", "ns")}.get(kind, "")
+    return np.full(n, fill, dtype=object if kind not in "fiubM" else None)
+
+
 def tracking_table(blocks: list[Block], source: str) -> pd.DataFrame:
     """The TrackingTable of all navigation observables in ``blocks``, time ordered."""
-    parts = []
-    for block in blocks:
-        for cols in _rows(block):
-            n = len(cols["record"])
-            parts.append(tt.build(n, source=source, flags=0, **cols))
+    parts = [cols for block in blocks for cols in _rows(block)]
     if not parts:
         return tt.empty({"format_code": "int64"})
-    df = pd.concat(parts, ignore_index=True)
+    sizes = [len(p["record"]) for p in parts]
+    names = list(dict.fromkeys(k for p in parts for k in p))
+    columns = {}
+    for name in names:
+        like = next(p[name] for p in parts if name in p)
+        columns[name] = np.concatenate([
+            np.broadcast_to(np.asarray(p[name]), (n,)) if name in p else _missing_like(like, n)
+            for p, n in zip(parts, sizes)])
+    df = tt.build(sum(sizes), source=source, flags=0, **columns)
     return df.sort_values(["epoch", "record"], kind="stable").reset_index(drop=True)
 
 
