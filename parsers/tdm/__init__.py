@@ -21,7 +21,7 @@ from parsers.tdm import keywords, kvn, times, xml
 from parsers.tdm.message import Message, Segment
 from parsers.tdm.observations import message, tracking
 
-__all__ = ["read", "sniff", "write", "Message", "Segment"]
+__all__ = ["read", "sniff", "write", "Message", "Segment", "keywords", "times"]
 
 
 def sniff(head: bytes) -> bool:
