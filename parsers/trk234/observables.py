@@ -8,12 +8,13 @@ Rows per format code (``value`` in the format's own unit, named in ``unit``):
 - 4/5 PN ranging phase: ``pn_phase_uplink`` / ``pn_phase_downlink`` (RU)
 - 6 Doppler count: ``doppler_count_1way/2way/3way`` (cycles), by the Doppler mode
 - 7 sequential range and 14 PN range: ``range`` (RU)
-- 8 angles: ``angle_1`` and ``angle_2`` (rad; the SIS gives degrees; ``ang_type`` kept)
+- 8 angles: ``angle_1`` and ``angle_2`` (rad from degrees; ``angle_type`` keeps the SIS code)
 - 11 DRVID: ``drvid`` (RU)
 - 16 carrier frequency observable: ``carrier_freq`` (Hz), one row per observation
 - 17 total count phase: ``total_phase`` (cycles), one row per observation
 
-Observation k of formats 16/17 is tagged at the SFDU time + k * obs_cnt_time. Formats
+Not checked against the SIS text (no copy here): the degree unit of angles, the RU unit
+of ranging phases and DRVID, and the sample timing below. Observation k of formats 16/17 is tagged at the SFDU time + k * obs_cnt_time. Formats
 9 (ramps) go to the ramp table; 10, 12, 13, 15 carry no navigation observable here and
 stay in the record blocks only. Every row keeps ``format_code`` and ``record`` (index of
 its SFDU in the file), so all of that SFDU's fields can be found in the blocks.
