@@ -201,3 +201,14 @@ def test_sniff(kvn, xmlf):
     assert tdm.sniff(kvn("TDMExample2.txt").read_bytes()[:64])
     assert tdm.sniff(xmlf("TDMExample2.xml").read_bytes()[:256])
     assert not tdm.sniff(b"NJPL2I00C123")
+
+
+def test_leap_second_scales_match_published_offsets():
+    # IERS Bulletin C: TAI-UTC = 34 s until 2012-06-30, 35 s from 2012-07-01; GPS = TAI - 19 s; TT = TAI + 32.184 s.
+    gps = np.array(["2012-06-30T12:00:15", "2012-07-01T00:00:16"], dtype="datetime64[ns]")
+    assert list(tdm.times.to_utc(gps, "GPS")) == list(np.array(["2012-06-30T12:00:00", "2012-07-01T00:00:00"],
+                                                                dtype="datetime64[ns]"))
+    tt_ = np.array(["2013-01-01T00:01:07.184"], dtype="datetime64[ns]")
+    assert tdm.times.to_utc(tt_, "TT")[0] == np.datetime64("2013-01-01T00:00:00", "ns")
+    utc = np.array(["2016-12-31T23:59:59", "2017-01-01T00:00:00"], dtype="datetime64[ns]")
+    assert list(tdm.times.to_utc(tdm.times.from_utc(utc, "TAI"), "TAI")) == list(utc)
