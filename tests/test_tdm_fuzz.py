@@ -9,11 +9,9 @@ from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
 from parsers import ParseError, tdm
-from tests.conftest import SHARED_DATA
 
 pytestmark = pytest.mark.realdata
-_SEEDS = [SHARED_DATA / "tdm" / "kvn" / "TDMExample8.txt", SHARED_DATA / "tdm" / "xml" / "TDMExample8.xml",
-          SHARED_DATA / "tdm" / "kvn" / "TDMExampleAllKeywordsSingleDiff.txt"]
+_SEEDS = ["kvn/TDMExample8.txt", "xml/TDMExample8.xml", "kvn/TDMExampleAllKeywordsSingleDiff.txt"]
 _FUZZ = settings(max_examples=70, deadline=None, suppress_health_check=[HealthCheck.function_scoped_fixture])
 
 
@@ -27,14 +25,14 @@ def _only_parse_error(tmp_path: Path, blob: bytes) -> None:
             pass
 
 
-def _seed(i: int) -> bytes:
-    return _SEEDS[i].read_bytes() if _SEEDS[i].is_file() else b""
+def _seed(shared_data: Path, i: int) -> bytes:
+    return (shared_data / "tdm" / _SEEDS[i]).read_bytes()
 
 
 @_FUZZ
 @given(st.integers(0, 2), st.floats(0, 1))
 def test_truncated(tmp_path, shared_data, i, frac):
-    raw = _seed(i)
+    raw = _seed(shared_data, i)
     _only_parse_error(tmp_path, raw[:int(len(raw) * frac)])
 
 
@@ -42,7 +40,7 @@ def test_truncated(tmp_path, shared_data, i, frac):
 @given(st.integers(0, 2), st.lists(st.tuples(st.floats(0, 1), st.sampled_from(list(b"=<>/ \n\t-.:TZ0123456789AEx&"))),
                                    min_size=1, max_size=6))
 def test_mangled(tmp_path, shared_data, i, edits):
-    raw = bytearray(_seed(i))
+    raw = bytearray(_seed(shared_data, i))
     for where, byte in edits:
         raw[min(int(where * len(raw)), len(raw) - 1)] = byte
     _only_parse_error(tmp_path, bytes(raw))
