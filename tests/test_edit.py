@@ -5,9 +5,10 @@ import pandas as pd
 import pytest
 
 from odpipe.preprocess import ambiguity, weights
-from odpipe.preprocess.edit import EditConfig, edit
+from odpipe.preprocess.edit import EditConfig, blunders, edit
 from odpipe.preprocess.flags import Flag, names, summary
 from odpipe.preprocess.robust import outliers
+from parsers import table
 from parsers.table import build
 
 T0 = np.datetime64("2012-04-09T00:00:00", "ns")
@@ -198,3 +199,15 @@ def test_utdf_validity_bits_decide(shared_data):
         want = (byte51[tab.loc[rows, "record"].to_numpy()] >> bit) & 1 == 0
         assert np.array_equal(bad[rows.to_numpy()], want), obs
     assert bad.sum() == 633
+
+
+def test_blunders_never_mix_observables_sharing_a_pass_id():
+    # Doppler (Hz) and range (m) of one station numbered as one pass, as a simulator may do
+    n = 120
+    t = np.datetime64("2003-06-03T00:00", "ns") + np.arange(n) * np.timedelta64(60, "s")
+    dop = table.build(n, epoch=t, observable="doppler_2way", value=1000.0 + 0.01 * np.arange(n), station_rx="DSS-14",
+                      station_tx="DSS-14", count_time=60.0, pass_id=0)
+    rng = table.build(12, epoch=t[::10], observable="range", value=2.9e8 + 3.7e5 * np.arange(12), station_rx="DSS-14",
+                      station_tx="DSS-14", pass_id=0)
+    tab = pd.concat([dop, rng], ignore_index=True)
+    assert not blunders(tab).any()

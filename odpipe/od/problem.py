@@ -76,12 +76,13 @@ class TrackingProblem:
 
     force_models: spacecraft id -> :class:`ForceModel` (without the estimated
     maneuvers and stochastic accelerations: the problem adds them);
-    lookback: s before a segment start covered for light time and count intervals.
+    lookback: s before a segment start covered for light time and count intervals;
+    epochs: where transitions will be asked (the filter grid), evaluated per segment in one pass.
     """
 
     def __init__(self, registry, rows: pd.DataFrame, times: np.ndarray, force_models: dict,
                  setup: MeasurementSetup, t_start: float, t_end: float, lookback: float = 120.0,
-                 rtol: float = 1e-12, atol: float = 1e-6):
+                 rtol: float = 1e-12, atol: float = 1e-6, epochs=()):
         self.registry = registry
         self.rows = rows.reset_index(drop=True)
         self.times = np.asarray(times, float)
@@ -90,6 +91,7 @@ class TrackingProblem:
         self.force_models, self.setup = dict(force_models), setup
         self.t_start, self.t_end = float(t_start), float(t_end)
         self.lookback, self.rtol, self.atol = lookback, rtol, atol
+        self.epochs = np.asarray(epochs, float)
         self.n_propagations = 0
         self._segments: list[_Segment] = []
         self._last = (None, None)   # (segment, x1) of the last transition, to skip re-checks
@@ -174,18 +176,25 @@ class TrackingProblem:
             idx += ix["stochastic"]
         return replace(fm, components=comps), names, idx
 
-    def _build(self, a, x0) -> _Segment:
+    def trajectories(self, a: float, x0: np.ndarray) -> tuple[float, dict, dict]:
+        """(segment end b, sc -> reference trajectory from ``a`` through ``x0``, sc -> registry indices
+        of its parameters); no measurement is evaluated (products use this after a fit)."""
         later = self._breaks[self._breaks > a]
         b = float(later[0]) if later.size else self.t_end
-        self._segments = [s for s in self._segments if s.b <= a or s.a >= b]
         trajs, pidx = {}, {}
         for sc, ix in self._sc.items():
             fm, names, idx = self._segment_model(sc, x0, a, b)
             dv_idx = ix["maneuvers"].get(a)
             dv = x0[dv_idx] if dv_idx is not None else None
             trajs[sc] = SegmentTrajectory(x0[ix["state"]], a, b, fm, names, dv, self.lookback, self.rtol, self.atol)
+            trajs[sc].preload(self.epochs[(self.epochs > a) & (self.epochs <= b)])
             pidx[sc] = np.array(idx + (dv_idx or []), int)
             self.n_propagations += 1
+        return b, trajs, pidx
+
+    def _build(self, a, x0) -> _Segment:
+        b, trajs, pidx = self.trajectories(a, x0)
+        self._segments = [s for s in self._segments if s.b <= a or s.a >= b]
         lo = int(np.searchsorted(self.times, a, "left"))
         hi = self.times.size if b >= self.t_end else int(np.searchsorted(self.times, b, "left"))
         seg = _Segment(a, b, x0[self._key_idx].copy(), trajs, pidx, lo, hi, *self._evaluate(lo, hi, trajs, x0))

@@ -22,7 +22,7 @@ import numpy as np
 import pandas as pd
 
 from odpipe.preprocess.flags import Flag, set_flag, summary
-from odpipe.preprocess.passes import LINK, assign_passes
+from odpipe.preprocess.passes import LINK, assign_passes, link_id
 from odpipe.preprocess.robust import gross, outliers, spikes
 
 
@@ -86,7 +86,9 @@ def blunders(table: pd.DataFrame, config: EditConfig | None = None, use: np.ndar
     use = np.ones(len(table), dtype=bool) if use is None else np.asarray(use, dtype=bool)
     v = table["value"].to_numpy(dtype=float)
     use = use & np.isfinite(v) & np.isnan(range_modulus(table))
-    pid = table["pass_id"].to_numpy()
+    # one group per (link, pass): never judge one observable's values against another's
+    pid = pd.Series(link_id(table)).astype(str).add(":").add(table["pass_id"].astype(str).to_numpy())
+    pid = pd.factorize(pid)[0]
     bad = use & gross(v, pid, config.gross_k, use)
     return bad | spikes(_ns(table), v, pid, config.blunder_k, use & ~bad)
 

@@ -13,13 +13,15 @@ class EphemerisSegment:
 
     ``t_tdb`` (N,) TDB seconds past J2000, increasing; ``states`` (N,6) m, m/s in
     ICRF axes relative to ``center`` (NAIF name); ``covariances`` optional
-    (N,6,6) in m², m²/s, m²/s² at the same epochs.
+    (M,6,6) in m², m²/s, m²/s² at ``covariance_t_tdb`` (M,) (default: the
+    state epochs; a filter's grid is often coarser than the product's).
     """
 
     t_tdb: np.ndarray
     states: np.ndarray
     center: str = "earth"
     covariances: np.ndarray | None = None
+    covariance_t_tdb: np.ndarray | None = None
 
     def __post_init__(self):
         self.t_tdb = np.asarray(self.t_tdb, dtype=float)
@@ -30,5 +32,8 @@ class EphemerisSegment:
             raise ValueError("a segment needs at least two strictly increasing epochs")
         if self.covariances is not None:
             self.covariances = np.asarray(self.covariances, dtype=float)
-            if self.covariances.shape != (self.t_tdb.size, 6, 6):
-                raise ValueError(f"covariances must be ({self.t_tdb.size}, 6, 6), got {self.covariances.shape}")
+            tc = self.t_tdb if self.covariance_t_tdb is None else self.covariance_t_tdb
+            self.covariance_t_tdb = np.asarray(tc, dtype=float)
+            if self.covariances.shape != (self.covariance_t_tdb.size, 6, 6):
+                raise ValueError(f"covariances must be ({self.covariance_t_tdb.size}, 6, 6), "
+                                 f"got {self.covariances.shape}")

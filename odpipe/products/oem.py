@@ -52,7 +52,7 @@ def format_oem(segments: list[EphemerisSegment], object_name: str, object_id: st
         out.append("")
         if seg.covariances is not None:
             out += ["COVARIANCE_START"]
-            for e, cov in zip(epochs, seg.covariances / 1e6):
+            for e, cov in zip(epoch_strings(seg.covariance_t_tdb, time_system), seg.covariances / 1e6):
                 out += [f"EPOCH = {e}", "COV_REF_FRAME = ICRF"]
                 low = cov[_TRIL]
                 k = 0

@@ -1,0 +1,160 @@
+"""Run configuration (``runs/NAME.toml``): the schema, checked strictly.
+
+Times are UTC ISO strings; relative paths resolve against the config's folder;
+units are SI (m, m/s, s, m²) unless a key says otherwise (``*_deg``).
+Unknown keys, wrong types and missing required keys are errors naming the key
+and the file (:class:`odpipe.runs.schema.ConfigError`).
+"""
+
+from __future__ import annotations
+
+import tomllib
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Literal
+
+from odpipe.runs.schema import ConfigError, load
+
+
+@dataclass
+class RunSection:
+    name: str
+    output: Path = Path("out")  # runs go to OUTPUT/NAME (attempt folders and 'current')
+
+
+@dataclass
+class ArcSection:
+    spacecraft: str  # id as the tracking files give it, e.g. "181"
+    start: str
+    end: str
+
+
+@dataclass
+class DataSection:
+    files: list[Path]
+    observables: list[str] = field(default_factory=lambda: ["doppler_2way", "range"])
+    errors: Literal["raise", "report"] = "report"  # nightly: report a corrupt record and go on
+
+
+@dataclass
+class CalibrationSection:
+    media: bool = True  # false: the table's values are already corrected (or simulated without media)
+    tro: list[Path] = field(default_factory=list)
+    ion: list[Path] = field(default_factory=list)
+    ionex: list[Path] = field(default_factory=list)
+    smoothing_order: int = 10  # per-pass polynomial; -1 = none
+
+
+@dataclass
+class PreprocessSection:
+    count_time: float = 60.0  # s, Doppler compression target
+    partial: Literal["keep", "flag", "drop"] = "keep"
+    elevation_mask_deg: float = 10.0
+    blunder_k: float = 10.0
+    min_pass_samples: int = 10
+
+
+@dataclass
+class GravitySection:
+    body: str
+    file: Path
+    degree: int
+    partial_degree: int | None = None
+
+
+@dataclass
+class CylinderSection:
+    radius: float
+    length: float
+    rho_s: float = 0.0
+    rho_d: float = 0.0
+    axis: str | list[float] = "sun"  # spin axis: ICRF unit vector or 'sun'
+
+
+@dataclass
+class SrpSection:
+    cr_area: float = 0.0  # Cr·A, m² (cannonball)
+    cylinder: CylinderSection | None = None
+    occulters: list[str] = field(default_factory=lambda: ["earth", "moon"])
+
+
+@dataclass
+class DynamicsSection:
+    center: str
+    ephemeris: str = "de440"  # 'de440', 'de421' or a .bsp path
+    third_bodies: list[str] = field(default_factory=list)
+    gravity: list[GravitySection] = field(default_factory=list)
+    srp: SrpSection | None = None
+    mass: float = 1000.0  # kg
+    relativity: bool = False
+
+
+@dataclass
+class InitialStateSection:
+    epoch: str  # UTC
+    state: list[float]  # m, m/s, ICRF axes about dynamics.center
+
+
+@dataclass
+class StochasticSection:
+    sigma: float  # m/s², steady state, per RTN axis
+    tau: float  # s (0 = white per batch)
+    batch: float  # s
+
+
+@dataclass
+class EstimationSection:
+    sigma_position: float = 100e3
+    sigma_velocity: float = 1.0
+    srp_scale_sigma: float | None = 0.1
+    stochastic: StochasticSection | None = None
+    data_sigma: dict[str, float] = field(default_factory=lambda: {"range": 2.0, "doppler_2way": 1e-4})
+    range_bias_sigma: float | None = 5.0
+    maneuver_plan: Path | None = None  # planned maneuvers (parsers.maneuvers schema)
+    edit_k: list[float] = field(default_factory=lambda: [float("inf"), 10.0, 5.0])
+    max_iter: int = 10
+    reweight: bool = True
+    block: float = 600.0
+
+
+@dataclass
+class ProductsSection:
+    oem: bool = True
+    spk: bool = True
+    naif_id: int = -999
+    object_name: str = ""
+    step: float = 60.0  # s between trajectory product states
+    plots: bool = True
+
+
+@dataclass
+class RunConfig:
+    run: RunSection
+    arc: ArcSection
+    data: DataSection
+    dynamics: DynamicsSection
+    initial_state: InitialStateSection
+    calibration: CalibrationSection = field(default_factory=CalibrationSection)
+    preprocess: PreprocessSection = field(default_factory=PreprocessSection)
+    estimation: EstimationSection = field(default_factory=EstimationSection)
+    products: ProductsSection = field(default_factory=ProductsSection)
+    path: Path | None = None
+    text: str = ""
+
+
+def load_config(path) -> RunConfig:
+    """Read and check a run configuration file."""
+    path = Path(path).resolve()
+    text = path.read_text()
+    try:
+        data = tomllib.loads(text)
+    except tomllib.TOMLDecodeError as exc:
+        raise ConfigError(path, "", f"not valid TOML: {exc}") from None
+    for reserved in ("path", "text"):
+        if reserved in data:
+            raise ConfigError(path, reserved, "unknown key")
+    cfg = load(RunConfig, data, path)
+    if len(cfg.initial_state.state) != 6:
+        raise ConfigError(path, "initial_state.state", "needs 6 numbers (m, m/s)")
+    cfg.path, cfg.text = path, text
+    return cfg

@@ -1,0 +1,67 @@
+"""Ingest: read every tracking file of a run into one TrackingTable and one ramp table.
+
+Each file's format is detected (:mod:`parsers.formats`); a ``.parquet`` file
+is a TrackingTable the project wrote itself (:mod:`odpipe.preprocess.store`,
+ramps beside it), so any stage's output can feed a run. In ``errors="report"``
+mode a corrupt record is reported with its file and offset and skipped; a file
+no reader recognises is reported and skipped; nothing else is lost.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from pathlib import Path
+
+import pandas as pd
+
+from odpipe.preprocess import store as table_store
+from parsers import ParseError, TrackingData
+from parsers.formats import read_any
+from parsers.ramps import RampStore
+from parsers.table import empty_ramps
+
+
+@dataclass
+class Ingested:
+    table: pd.DataFrame
+    ramps: pd.DataFrame
+    store: RampStore
+    log: list[str] = field(default_factory=list)
+
+
+def _read(path: Path, errors: str) -> TrackingData:
+    if path.suffix == ".parquet":
+        table, ramps = table_store.read(path)
+        return TrackingData(table, ramps)
+    return read_any(path, errors=errors)
+
+
+def ingest(files: list[Path], errors: str = "report") -> Ingested:
+    """Read ``files``; rows sorted by time tag (stable), index renumbered from 0."""
+    tables, ramps, log = [], [], []
+    for path in files:
+        try:
+            data = _read(path, errors)
+        except ParseError as exc:
+            if errors == "raise":
+                raise
+            log.append(f"SKIPPED {exc}")
+            continue
+        if not hasattr(data, "table"):
+            log.append(f"SKIPPED {path}: not a tracking file")
+            continue
+        tables.append(data.table)
+        if data.ramps is not None and len(data.ramps):
+            ramps.append(data.ramps)
+        log.append(f"read {path.name}: {len(data.table)} rows, "
+                   f"{0 if data.ramps is None else len(data.ramps)} ramp segments, {len(data.report)} records skipped")
+        log += [f"  skipped: {err}" for err in data.report]
+    if not tables:
+        raise ValueError("no tracking data could be read from " + ", ".join(map(str, files)))
+    table = pd.concat(tables, ignore_index=True).sort_values("epoch", kind="stable").reset_index(drop=True)
+    ramp_table = pd.concat(ramps, ignore_index=True) if ramps else empty_ramps()
+    store = RampStore(ramp_table)
+    if len(store.findings):
+        counts = store.findings.groupby("kind").size() if "kind" in store.findings else {}
+        log.append("ramp findings: " + ", ".join(f"{k} {n}" for k, n in dict(counts).items()))
+    return Ingested(table, ramp_table, store, log)

@@ -1,0 +1,179 @@
+"""``odpipe run``: one arc through every stage into a run directory.
+
+ingest → geometry (a priori trajectory) → media calibration → Doppler
+compression → editing → iterated filter-smoother → products. Every product is
+written into a new attempt folder; the run becomes ``current`` only when all
+of them are there (:mod:`odpipe.runs.rundir`), so a failed or killed run
+leaves the previous good products untouched. An arc whose config and input
+files are unchanged since its last complete run is skipped.
+"""
+
+from __future__ import annotations
+
+import json
+import time
+from pathlib import Path
+
+import numpy as np
+import pandas as pd
+
+from odpipe.analysis import maneuvers as maneuver_report
+from odpipe.environment.stations import StationCatalog
+from odpipe.media.apply import calibrate
+from odpipe.media.ionosphere import IonexModel
+from odpipe.media.model import MediaModel
+from odpipe.od.arc import fit_arc
+from odpipe.pipeline import setup as build
+from odpipe.pipeline.config import RunConfig, load_config
+from odpipe.pipeline.geometry import add_geometry
+from odpipe.pipeline.ingest import ingest
+from odpipe.pipeline.products import fitted_segments
+from odpipe.preprocess.compress import compress
+from odpipe.preprocess.edit import EditConfig, edit
+from odpipe.preprocess.flags import summary as flag_summary
+from odpipe.products import residuals
+from odpipe.products.atomic import write_text
+from odpipe.products.oem import write_oem
+from odpipe.products.spk import write_spk
+from odpipe.runs import rundir
+from odpipe.runs.report import Section, write_report
+from parsers.ionex import read_ionex
+from parsers.trk223 import read_trk223
+
+
+class RunLog:
+    """Lines to the terminal (with elapsed time) and to the run's log file."""
+
+    def __init__(self, progress):
+        self.progress, self.lines, self.t0 = progress, [], time.perf_counter()
+
+    def __call__(self, line: str) -> None:
+        stamped = f"[{time.perf_counter() - self.t0:7.1f} s] {line}"
+        self.lines.append(stamped)
+        if self.progress:
+            self.progress(stamped)
+
+
+def run_config(path, *, force: bool = False, progress=print) -> dict:
+    """Run the arc of config ``path``; returns ``{"status": "complete" | "skipped", "run": folder, ...}``."""
+    cfg = load_config(path)
+    root = cfg.run.output / cfg.run.name
+    fingerprint = rundir.fingerprint(cfg.text, build.input_files(cfg))
+    if not force and rundir.up_to_date(root, fingerprint):
+        if progress:
+            progress(f"{cfg.run.name}: unchanged since its last complete run, skipped ({root / 'current'})")
+        return {"status": "skipped", "run": str(root / "current")}
+    attempt = rundir.start(root)
+    log = RunLog(progress)
+    try:
+        summary = _run(cfg, attempt, log)
+        log(f"complete; products in {root / 'current'}")
+        write_text(attempt.path / "run.log", "\n".join(log.lines) + "\n")
+        attempt.finish(fingerprint, summary)
+        return {"status": "complete", "run": str(root / "current"), **summary}
+    except BaseException as exc:
+        log(f"FAILED: {exc!r}")
+        write_text(attempt.path / "run.log", "\n".join(log.lines) + "\n")
+        attempt.fail(exc)
+        raise
+
+
+def _run(cfg: RunConfig, attempt, log: RunLog) -> dict:
+    data = ingest(cfg.data.files, cfg.data.errors)
+    for line in data.log:
+        log(line)
+    table = data.table[data.table["spacecraft"].astype(str) == cfg.arc.spacecraft].reset_index(drop=True)
+    table = table[table["observable"].isin(cfg.data.observables)].reset_index(drop=True)
+    log(f"ingest: {len(table)} rows of spacecraft {cfg.arc.spacecraft} "
+        f"({', '.join(f'{k} {v}' for k, v in table['observable'].value_counts().items())})")
+
+    fm = build.force_model(cfg)
+    setup = build.arc_setup(cfg, fm, data.store)
+    catalog = StationCatalog.default()
+    apriori = build.a_priori_trajectory(setup)
+    table = add_geometry(table, apriori, fm.ephemeris, catalog)
+    log(f"geometry: elevation and light time from the a priori trajectory ({apriori.n_steps} steps)")
+
+    cal = cfg.calibration
+    if cal.media:
+        model = MediaModel(read_trk223(*cal.tro, *cal.ion) if (cal.tro or cal.ion) else None,
+                           IonexModel(read_ionex(*cal.ionex)) if cal.ionex else None)
+        table, _ = calibrate(table, model, ramps=data.store, catalog=catalog,
+                             order=None if cal.smoothing_order < 0 else cal.smoothing_order)
+        log(f"calibrate: media on {int(np.isfinite(table['media_m']).sum())} rows; "
+            f"sources {dict(table['media_source'].value_counts().head(4))}")
+    else:
+        log("calibrate: media corrections off (calibration.media = false)")
+
+    pre = cfg.preprocess
+    rtlt = float(np.nanmedian(table["rtlt_s"])) if np.isfinite(table["rtlt_s"]).any() else 0.0
+    n_raw = len(table)
+    table, creport = compress(table, pre.count_time, ramps=data.ramps, partial=pre.partial, ramp_delay=rtlt)
+    log(f"compress: {n_raw} rows -> {len(table)} at {pre.count_time:g} s count time")
+    edit_cfg = EditConfig(min_elevation=np.radians(pre.elevation_mask_deg), blunder_k=pre.blunder_k,
+                          min_pass_samples=pre.min_pass_samples,
+                          arc=(np.datetime64(cfg.arc.start, "ns"), np.datetime64(cfg.arc.end, "ns")))
+    table, edits = edit(table, data.ramps, edit_cfg)
+    log("edit: " + ", ".join(f"{r} {n}" for r, n in zip(edits["reason"], edits["rows"]) if n))
+
+    t0 = time.perf_counter()
+    arc = fit_arc(table, setup)
+    fit_seconds = time.perf_counter() - t0
+    for h in arc.history:
+        log(f"fit iteration: {json.dumps(h, default=float)}")
+    log(f"fit: {'converged' if arc.converged else 'NOT converged'} in {len(arc.history)} iterations, {fit_seconds:.1f} s")
+    return _products(cfg, attempt, log, table, arc, edits, fit_seconds)
+
+
+def _products(cfg, attempt, log, table, arc, edits, fit_seconds) -> dict:
+    res = arc.residuals
+    stats = residuals.statistics(res)
+    table.to_parquet(attempt.product("tracking.parquet"))
+    res.to_parquet(attempt.product("residuals.parquet"))
+    write_text(attempt.product("residual_statistics.csv"), stats.to_csv(index=False))
+    params = arc.parameters.copy()
+    write_text(attempt.product("parameters.csv"), params.to_csv(index=False))
+    man_rows = man_stats = None
+    if len(arc.maneuvers):
+        mt = arc.maneuvers
+        write_text(attempt.product("maneuvers.csv"), mt.to_csv(index=False))
+        man_rows, man_stats = maneuver_report.evaluate(mt)
+        write_text(attempt.product("maneuver_evaluation.csv"), man_stats.to_csv())
+    arc.solution.save(attempt.product("solution.npz"))
+    segments = fitted_segments(arc, cfg.products.step)
+    name = cfg.products.object_name or cfg.arc.spacecraft
+    if cfg.products.oem:
+        write_oem(attempt.product("trajectory.oem"), segments, name, cfg.arc.spacecraft,
+                  comments=[f"odpipe run {cfg.run.name}: smoothed solution"])
+    if cfg.products.spk:
+        write_spk(attempt.product("trajectory.bsp"), segments, cfg.products.naif_id)
+    figures = []
+    if cfg.products.plots:
+        for which in ("prefit", "postfit"):
+            png = attempt.product(f"residuals_{which}.png")
+            residuals.plot(res, png, which, f"{cfg.run.name}: {which} residuals")
+            figures.append((png, f"{which} residuals along the line of sight"))
+    summary = _summary(cfg, arc, stats, fit_seconds)
+    write_text(attempt.product("summary.json"), json.dumps(summary, indent=1, default=float))
+    sections = [Section("Residuals").table(stats), Section("Editing").table(edits)]
+    for png, caption in figures:
+        sections[0].figure(png, caption)
+    sections.append(Section("Estimated parameters").table(params))
+    if man_stats is not None:
+        sections.append(Section("Maneuvers (designed − estimated)").table(man_rows).table(man_stats.reset_index()))
+    write_report(attempt.product("report.html"), f"odpipe run {cfg.run.name}", summary, sections)
+    log(f"products: OEM/SPK ({sum(len(s.t_tdb) for s in segments)} states in {len(segments)} segments), "
+        "residuals, parameters, report.html")
+    return summary
+
+
+def _summary(cfg, arc, stats, fit_seconds) -> dict:
+    out = {"arc": cfg.run.name, "spacecraft": cfg.arc.spacecraft, "start": cfg.arc.start, "end": cfg.arc.end,
+           "converged": bool(arc.converged), "iterations": len(arc.history), "fit_seconds": round(fit_seconds, 2)}
+    for row in stats.itertuples(index=False):
+        scale, unit = residuals.display_scale(row.observable)
+        out[f"postfit RMS {row.observable} {row.station_rx} ({unit})"] = round(row.postfit_rms * scale, 5)
+    sig = arc.covariances[0]
+    out["epoch position sigma (m)"] = round(float(np.sqrt(np.trace(sig[:3, :3]))), 3)
+    out["epoch velocity sigma (mm/s)"] = round(float(np.sqrt(np.trace(sig[3:, 3:]))) * 1e3, 4)
+    return out

@@ -1,0 +1,114 @@
+"""From a run configuration to the dynamics and the arc-fit set-up."""
+
+from __future__ import annotations
+
+import numpy as np
+import pandas as pd
+
+from odpipe.dynamics import forces as F
+from odpipe.dynamics.propagator import propagate
+from odpipe.environment.ephemeris import Ephemeris
+from odpipe.environment.gravity import read_gravity
+from odpipe.environment.stations import StationCatalog
+from odpipe.estimation.registry import GaussMarkov
+from odpipe.frames.earth import gcrs_to_itrs
+from odpipe.frames.local import rtn_matrix
+from odpipe.measurements import MeasurementSetup
+from odpipe.od.arc import ArcSetup, ManeuverPlan
+from odpipe.pipeline.config import RunConfig
+from odpipe.time import utc_to_tdb
+from parsers.maneuvers import read_plan
+
+
+def tdb(utc_iso: str) -> float:
+    """TDB s past J2000 of a UTC ISO string."""
+    return float(utc_to_tdb(np.datetime64(utc_iso, "ns")))
+
+
+def force_model(cfg: RunConfig) -> F.ForceModel:
+    """The configured dynamics (without estimated maneuvers and stochastic accelerations)."""
+    dyn = cfg.dynamics
+    eph = Ephemeris.open(str(dyn.ephemeris))
+    comps = []
+    if dyn.third_bodies:
+        comps.append(F.PointMasses(list(dyn.third_bodies)))
+    for g in dyn.gravity:
+        comps.append(F.SphericalHarmonics(g.body, read_gravity(g.file), g.degree, g.partial_degree))
+    if dyn.srp is not None:
+        surfaces = []
+        if dyn.srp.cylinder is not None:
+            c = dyn.srp.cylinder
+            axis = c.axis if isinstance(c.axis, str) else np.asarray(c.axis, float)
+            surfaces.append(F.Cylinder(axis, c.radius, c.length, c.rho_s, c.rho_d))
+        comps.append(F.SolarRadiationPressure(dyn.srp.cr_area, surfaces, tuple(dyn.srp.occulters)))
+    if dyn.relativity:
+        comps.append(F.Relativity())
+    return F.ForceModel(dyn.center, comps, dyn.mass, eph)
+
+
+def maneuver_plans(cfg: RunConfig, fm: F.ForceModel, state0: np.ndarray, t0: float) -> list[ManeuverPlan]:
+    """Planned impulsive maneuvers in the arc, their ΔV turned to ICRF along the a priori trajectory."""
+    path = cfg.estimation.maneuver_plan
+    if path is None:
+        return []
+    plan = read_plan(path)
+    t1 = tdb(cfg.arc.end)
+    plans, applied = [], []
+    for row in plan.sort_values("epoch").itertuples(index=False):
+        if row.kind != "impulsive":
+            raise ValueError(f"{path}: maneuver {row.name} is a finite burn; the arc fit estimates impulsive ones")
+        t = tdb(str(np.datetime64(row.epoch, "ns")))
+        if not t0 < t < t1:
+            continue
+        dv = np.array([row.dv1, row.dv2, row.dv3], float)
+        if row.frame != "ICRF":
+            model = F.ForceModel(fm.center, fm.components + applied, fm.mass, fm.ephemeris, fm.central_gm)
+            x = propagate(state0, t0, t, model, with_stm=False).state(t)[0]
+            rot = rtn_matrix(x[:3], x[3:]) if row.frame == "RTN" else _vnb_matrix(x)
+            dv = rot.T @ dv
+        applied.append(F.ImpulsiveManeuver(t, dv))
+        sigma = row.sigma_dv if np.isfinite(row.sigma_dv) else 0.01
+        plans.append(ManeuverPlan(str(row.name), t, tuple(dv), float(sigma)))
+    return plans
+
+
+def _vnb_matrix(x):
+    v = x[3:] / np.linalg.norm(x[3:])
+    n = np.cross(x[:3], x[3:])
+    n /= np.linalg.norm(n)
+    return np.array([v, n, np.cross(v, n)])
+
+
+def arc_setup(cfg: RunConfig, fm: F.ForceModel, ramps) -> ArcSetup:
+    est = cfg.estimation
+    start, end = tdb(cfg.arc.start), tdb(cfg.arc.end)
+    t_state = tdb(cfg.initial_state.epoch)
+    state0 = np.asarray(cfg.initial_state.state, float)
+    if abs(t_state - start) > 1e-6:  # move the a priori state to the arc start
+        state0 = propagate(state0, t_state, start, fm, with_stm=False).state(start)[0]
+    meas = MeasurementSetup(fm.ephemeris, StationCatalog.default(), ramps=ramps, gcrs_to_itrs=gcrs_to_itrs)
+    stochastic = None if est.stochastic is None else GaussMarkov(est.stochastic.tau, est.stochastic.sigma,
+                                                                 est.stochastic.batch)
+    return ArcSetup(spacecraft=cfg.arc.spacecraft, start=start, end=end, state0=state0, force_model=fm,
+                    measurements=meas, sigma_position=est.sigma_position, sigma_velocity=est.sigma_velocity,
+                    srp_scale_sigma=est.srp_scale_sigma if cfg.dynamics.srp is not None else None,
+                    stochastic=stochastic, maneuvers=tuple(maneuver_plans(cfg, fm, state0, start)),
+                    data_sigma=dict(est.data_sigma), range_bias_sigma=est.range_bias_sigma,
+                    edit_k=tuple(est.edit_k), max_iter=est.max_iter, reweight=est.reweight, block=est.block)
+
+
+def a_priori_trajectory(setup: ArcSetup):
+    """The a priori trajectory over the arc (designed maneuvers applied), for geometry."""
+    fm = setup.force_model
+    burns = [F.ImpulsiveManeuver(m.epoch, m.designed) for m in setup.maneuvers]
+    model = F.ForceModel(fm.center, fm.components + burns, fm.mass, fm.ephemeris, fm.central_gm)
+    return propagate(setup.state0, setup.start, setup.end, model, with_stm=False)
+
+
+def input_files(cfg: RunConfig) -> list:
+    """Every file whose bytes decide the run's result."""
+    files = list(cfg.data.files) + cfg.calibration.tro + cfg.calibration.ion + cfg.calibration.ionex
+    files += [g.file for g in cfg.dynamics.gravity]
+    if cfg.estimation.maneuver_plan is not None:
+        files.append(cfg.estimation.maneuver_plan)
+    return files
