@@ -177,3 +177,29 @@ def test_cylinder_closed_form_vs_facet_sum():
         F_ref = np.zeros(3)
         surfaces_force(e, np.array(rows), F_ref, np.zeros((n + 1, 3)), np.zeros((n + 1, 3)), J)
         np.testing.assert_allclose(F, F_ref, rtol=1e-5, atol=1e-6)
+
+
+@pytest.mark.realdata
+@pytest.mark.parametrize("body", ["earth", "moon"])
+def test_body_fixed_field_through_the_force_model(shared_data, eph, body):
+    """Field acceleration in ICRF = R^T grad U(R r), with R from the frames module directly
+    and U summed with scipy (orientation convention of ITRS and DE421 PA checked)."""
+    from test_gravity_harmonics import _potential
+
+    from odpipe.frames.earth import gcrs_to_itrs
+    from odpipe.frames.moon import moon_pa_to_icrf
+
+    name = "gravity/gmat/JGM3.cof" if body == "earth" else "gravity/gmat/LP165P.cof"
+    g = read_gravity(shared_data / name).truncated(6)
+    fm = ForceModel(body, [SphericalHarmonics(body, g, 6)], ephemeris=eph)
+    model = compile_model(fm, T0, T0 + 86400.0, [], False)
+    t = T0 + 30000.0
+    x = np.r_[np.array([0.8, -0.5, 0.45]) * 1.15 * g.radius, 0.0, 0.0, 0.0]
+    acc = _accel(model, t, x)[0]
+    R = gcrs_to_itrs(t) if body == "earth" else moon_pa_to_icrf(t).T
+    r_bf = R @ x[:3]
+    h = 1.0
+    grad = np.array([(_potential(r_bf + e, g.gm, g.radius, g.C, g.S, 6)
+                      - _potential(r_bf - e, g.gm, g.radius, g.C, g.S, 6)) / (2 * h) for e in np.eye(3) * h])
+    central = -g.gm * x[:3] / np.linalg.norm(x[:3]) ** 3
+    np.testing.assert_allclose(acc - central, R.T @ grad, rtol=0, atol=1e-8 * np.abs(grad).max())
