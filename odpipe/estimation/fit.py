@@ -25,9 +25,9 @@ import numpy as np
 import pandas as pd
 
 from .registry import ParameterRegistry
-from .smoother import smooth
+from .smoother import smooth_arrays
 from .solution import Solution, checksum
-from .srif import SRIF
+from .srif import SRIF, information_estimate, solve_information
 
 EDIT_INNOVATION = 1  # row rejected by the innovation (pre-fit) k-sigma test
 OUTSIDE_ARC = 2      # row time outside [t_start, t_end]
@@ -105,9 +105,10 @@ def _edit_k(options, it, prev_rms):
 class _Pass:
     """One filter-smoother pass about a reference."""
 
+    srif: SRIF          # the filter after the last grid epoch (n_est, consider a priori)
     refs: list          # reference vector at each grid epoch (after any stochastic step)
-    filtered: list      # Gaussian deviations, filter
-    smoothed: dict      # Gaussian deviations, smoother, by grid index
+    filtered: list      # filter information arrays (R, z) at each grid epoch
+    smoothed: dict      # smoother information arrays (R, z) by grid index
     blocks: list        # (grid index, rows, H, y) of each measurement block
     flags: np.ndarray
     prefit: np.ndarray
@@ -134,12 +135,12 @@ def _filter_smoother_pass(problem, obs, grid, steps, bounds, x_ref0, p_after, si
             xr[idx] = new
         refs.append(xr)
         srif.mark(k)
-        filt.append(srif.gaussian())
+        filt.append((srif.R, srif.z))
         rows = np.arange(bounds[k], bounds[k + 1])
         if rows.size:
             computed, H = problem.predict(grid[k], xr, rows)
             y = obs.value[rows] - computed
-            nu, s = srif.innovations(H, y, sig_row[rows], filt[-1])
+            nu, s = srif.innovations(H, y, sig_row[rows])
             bad = np.abs(nu) > edit_k * s
             flags[rows[bad]] |= EDIT_INNOVATION
             prefit[rows], innov[rows], innov_sig[rows] = y, nu, s
@@ -149,8 +150,17 @@ def _filter_smoother_pass(problem, obs, grid, steps, bounds, x_ref0, p_after, si
         srif.time_update(Phi)
     refs.append(xr)
     srif.mark(K)
-    filt.append(srif.gaussian())
-    return _Pass(refs, filt, smooth(srif), blocks, flags, prefit, innov, innov_sig)
+    filt.append((srif.R, srif.z))
+    return _Pass(srif, refs, filt, smooth_arrays(srif), blocks, flags, prefit, innov, innov_sig)
+
+
+def _gaussian(ps: _Pass, R, z):
+    f = ps.srif
+    return solve_information(R, z, f.n_est, f.c_bar, f.c_sigma)
+
+
+def _estimate(ps: _Pass, R, z):
+    return information_estimate(R, z, ps.srif.n_est, ps.srif.c_bar)
 
 
 def fit(problem: Problem, obs: Observations, t_start: float, t_end: float,
@@ -177,13 +187,15 @@ def fit(problem: Problem, obs: Observations, t_start: float, t_end: float,
         kk = _edit_k(options, it, prev_rms)
         ps = _filter_smoother_pass(problem, obs, grid, steps, bounds, x_ref0, p_after,
                                    sig_row, kk)
-        sm = ps.smoothed
+        needed = {0} | {b[0] for b in ps.blocks} | set(steps)
+        dx = {k: _estimate(ps, *ps.smoothed[k]) for k in needed}
         postfit = np.full(obs.time.size, np.nan)
         for k, rows, H, y in ps.blocks:
-            postfit[rows] = y - H @ sm[k].x
+            postfit[rows] = y - H @ dx[k]
         ok = ps.flags == 0
         rms = float(np.sqrt(np.mean((postfit[ok] / sig_row[ok]) ** 2)))
-        corr = np.max(np.abs(sm[0].x[:n_est]) / np.sqrt(np.diag(sm[0].P)[:n_est]))
+        P0 = _gaussian(ps, *ps.smoothed[0]).P
+        corr = np.max(np.abs(dx[0][:n_est]) / np.sqrt(np.diag(P0)[:n_est]))
         history.append({"iteration": it + 1, "postfit_rms": rms,
                         "prefit_rms": float(np.sqrt(np.mean((ps.prefit[ok] / sig_row[ok]) ** 2))),
                         "edited": int(np.sum(ps.flags & EDIT_INNOVATION > 0)),
@@ -191,10 +203,10 @@ def fit(problem: Problem, obs: Observations, t_start: float, t_end: float,
                         "scales": {str(g): float(v) for g, v in scale.items()}})
         # relinearize about the smoothed solution
         x_ref0 = x_ref0.copy()
-        x_ref0[:n_est] += sm[0].x[:n_est]
+        x_ref0[:n_est] += dx[0][:n_est]
         for k in steps:
             for j, (idx, _) in enumerate(steps[k]):
-                p_after[(k, j)] = ps.refs[k][idx] + sm[k].x[idx]
+                p_after[(k, j)] = ps.refs[k][idx] + dx[k][idx]
         rms_ok = prev_rms is not None and abs(rms - prev_rms) <= options.tol_rms * prev_rms
         prev_rms = rms
         if options.reweight:
@@ -211,14 +223,15 @@ def fit(problem: Problem, obs: Observations, t_start: float, t_end: float,
                               "postfit": postfit, "innovation": ps.innovation,
                               "innovation_sigma": ps.innovation_sigma, "sigma": sig_row,
                               "flags": ps.flags})
-    K = grid.size - 1
+    filt = [_gaussian(ps, R, z) for R, z in ps.filtered]
+    sm = [_gaussian(ps, *ps.smoothed[k]) for k in range(grid.size)]
     return Solution(
         names=reg.names, grid=grid,
-        filtered_x=refs + np.array([g.x for g in ps.filtered]),
-        filtered_P=np.array([g.P_consider for g in ps.filtered]),
-        smoothed_x=refs + np.array([sm[k].x for k in range(K + 1)]),
-        smoothed_P=np.array([sm[k].P for k in range(K + 1)]),
-        smoothed_P_consider=np.array([sm[k].P_consider for k in range(K + 1)]),
+        filtered_x=refs + np.array([g.x for g in filt]),
+        filtered_P=np.array([g.P_consider for g in filt]),
+        smoothed_x=refs + np.array([g.x for g in sm]),
+        smoothed_P=np.array([g.P for g in sm]),
+        smoothed_P_consider=np.array([g.P_consider for g in sm]),
         residuals=residuals, history=history, converged=converged,
         inputs={"observations": checksum(obs.time, obs.value, obs.sigma),
                 "apriori": checksum(reg.apriori, reg.sigma),

@@ -16,14 +16,20 @@ from .srif import SRIF, solve_information, triangularize
 
 
 def smooth(srif: SRIF) -> dict:
-    """Smoothed :class:`Gaussian` at every ``mark`` label in the filter's log."""
+    """Smoothed :class:`~.srif.Gaussian` at every ``mark`` label in the filter's log."""
+    return {k: solve_information(R, z, srif.n_est, srif.c_bar, srif.c_sigma)
+            for k, (R, z) in smooth_arrays(srif).items()}
+
+
+def smooth_arrays(srif: SRIF) -> dict:
+    """Smoothed information arrays ``(R, z)`` (rows in any order) at every ``mark`` label."""
     R, z = srif.R.copy(), srif.z.copy()
     n = srif.n
     out = {}
     for event in reversed(srif.log):
         kind = event[0]
         if kind == "mark":
-            out[event[1]] = solve_information(R, z, srif.n_est, srif.c_bar, srif.c_sigma)
+            out[event[1]] = (R, z)
         elif kind == "map":
             R = R @ event[1]
         else:

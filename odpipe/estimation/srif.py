@@ -56,15 +56,29 @@ class Gaussian:
         return np.sqrt(np.diag(self.P_consider))
 
 
+def information_estimate(R, z, n_est, c_bar, triangular=False) -> np.ndarray:
+    """Estimate only (no covariance) from an information array, consider part at ``c_bar``."""
+    n = R.shape[1]
+    T = np.column_stack([R, z]) if triangular else triangularize(np.column_stack([R, z]))
+    Rinv = _inverse(T[:n_est, :n_est])
+    return np.concatenate([Rinv @ (T[:n_est, n] - T[:n_est, n_est:n] @ c_bar), c_bar])
+
+
+def _inverse(R):
+    """Inverse of an upper-triangular matrix (LAPACK trtri; small, unthreaded)."""
+    Rinv, info = dtrtri(R)
+    if info != 0:
+        raise np.linalg.LinAlgError("singular square-root information matrix")
+    return Rinv
+
+
 def solve_information(R, z, n_est, c_bar, c_sigma, triangular=False) -> Gaussian:
     """Estimate and covariances from an information array (any row order unless
     ``triangular``, which skips the re-triangularization)."""
     n = R.shape[1]
     T = np.column_stack([R, z]) if triangular else triangularize(np.column_stack([R, z]))
     Ree, Rec, ze = T[:n_est, :n_est], T[:n_est, n_est:n], T[:n_est, n]
-    Rinv, info = dtrtri(Ree)
-    if info != 0:
-        raise np.linalg.LinAlgError("singular square-root information matrix")
+    Rinv = _inverse(Ree)
     S = Rinv @ Rec                          # -d(x_e)/d(c)
     x = np.concatenate([Rinv @ (ze - Rec @ c_bar), c_bar])
     P = np.zeros((n, n))
@@ -168,15 +182,20 @@ class SRIF:
         return solve_information(self.R, self.z, self.n_est, self.c_bar, self.c_sigma,
                                  triangular=True)
 
-    def innovations(self, H, y, sigma, g: Gaussian | None = None):
+    def innovations(self, H, y, sigma):
         """Pre-update residuals ``y - H x`` and their predicted standard deviations.
 
         The prediction variance includes the estimate's covariance with the
-        consider parameters' effect, and the measurement noise. ``g``: the current
-        :meth:`gaussian`, if already computed.
+        consider parameters' effect, and the measurement noise.
         """
-        g = self.gaussian() if g is None else g
         H = np.atleast_2d(H)
-        nu = np.asarray(y) - H @ g.x
-        s2 = np.sum((H @ g.P_consider) * H, axis=1) + np.asarray(sigma, float) ** 2
-        return nu, np.sqrt(s2)
+        if self.n_est == self.n:        # H P H^T = |R^-T H^T|^2, no covariance needed
+            Rinv = _inverse(self.R)
+            x = Rinv @ self.z
+            hph = np.sum((H @ Rinv) ** 2, axis=1)
+        else:
+            g = self.gaussian()
+            x = g.x
+            hph = np.sum((H @ g.P_consider) * H, axis=1)
+        nu = np.asarray(y) - H @ x
+        return nu, np.sqrt(hph + np.asarray(sigma, float) ** 2)
