@@ -23,12 +23,14 @@ year's 1 January 00:00 UTC + seconds of year + microseconds.
 
 :func:`read` gives one table row per observable a record carries (a set
 validity bit or a non-zero field): ``range`` as round-trip delay in s,
-Doppler as the Doppler shift in Hz = (delta count / delta t - 240 MHz bias) / M
-between consecutive records of one vehicle and pad (or count / interval for
-destruct Doppler; NaN for the first of a series), angles in rad. Extra
-columns: ``valid`` (the row's validity bit), ``validity`` (the byte), ``vid``,
-``tracker_type``, ``band_code``, ``data_interval_s``, ``doppler_count`` and
-``factor_m`` (Doppler rows). ``meta["records"]`` holds every field of every
+Doppler in Hz in the DSN sign convention of every ``doppler_*`` observable
+(Moyer: positive when the spacecraft recedes), i.e. minus the UTDF Doppler
+shift = (delta count / delta t - 240 MHz bias) / M between consecutive records
+of one vehicle and pad (or count / interval for destruct Doppler; NaN for the
+first of a series), angles in rad. Extra columns: ``valid`` (the row's
+validity bit), ``validity`` (the byte), ``vid``, ``tracker_type``,
+``band_code``, ``data_interval_s``, ``doppler_count``, ``factor_m`` and
+``doppler_shift_hz`` (the format's own signed shift, positive approaching). ``meta["records"]`` holds every field of every
 record (AGC, mode, antenna types, router, TDRSS-only bytes, ...; join on
 ``record``) and :func:`write` turns such a frame back into bytes, bit for bit.
 """
@@ -214,7 +216,7 @@ def _table(rec: pd.DataFrame, source: str) -> pd.DataFrame:
 
     bits = np.stack([valid & 1, (valid >> 1) & 1, (valid >> 2) & 1, (valid >> 2) & 1], axis=1).astype(bool)
     present = bits | np.stack([rng != 0, cnt != 0, a1 != 0, a2 != 0], axis=1)
-    value = np.stack([rng / 256e9, doppler_hz, a1 / 2**32 * TWO_PI,
+    value = np.stack([rng / 256e9, -doppler_hz, a1 / 2**32 * TWO_PI,
                       _signed_half_turn(a2 / 2**32 * TWO_PI)], axis=1)
     ctime = np.stack([np.zeros(n), count_time, np.zeros(n), np.zeros(n)], axis=1)
     doppler_name = np.where(two_way, "doppler_2way", "doppler_1way").astype(object)
@@ -235,6 +237,7 @@ def _table(rec: pd.DataFrame, source: str) -> pd.DataFrame:
         valid=bits.ravel()[flat], validity=valid[r], vid=col["vid"][r], tracker_type=tracker[r] >> 12,
         band_code=band[r], data_interval_s=interval[r], doppler_count=np.where(is_doppler, cnt[r], -1),
         factor_m=np.where(is_doppler, factor_m[r], np.nan),
+        doppler_shift_hz=np.where(is_doppler, doppler_hz[r], np.nan),
     )
 
 

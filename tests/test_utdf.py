@@ -48,9 +48,11 @@ def test_data_utd_matches_astro_utdf(shared_data):
     assert f"{az['value']:.9f}" == "5.852690027" and f"{el['value']:.9f}" == "0.953498911"
     assert _unix(az["epoch"]) == 1268960491  # Fri Mar 19 01:01:31 2010
     dop = _row(d, 1, "doppler_2way")
-    assert f"{dop['value']:.3f}" == "25608.177" and dop["count_time"] == 1.0
+    # Astro::UTDF's shift; the table's value carries the DSN sign (positive receding): minus the shift
+    assert f"{dop['doppler_shift_hz']:.3f}" == "25608.177" and dop["value"] == -dop["doppler_shift_hz"]
+    assert dop["count_time"] == 1.0
     assert dop["uplink_hz"] == 2050000000 and f"{dop['transponder_ratio']:.8f}" == "1.08597285"
-    range_rate = -C_KM_S / (2 * dop["uplink_hz"] * dop["transponder_ratio"]) * dop["value"]
+    range_rate = C_KM_S / (2 * dop["uplink_hz"] * dop["transponder_ratio"]) * dop["value"]  # DSN: F = 2 M f rdot / c
     assert f"{range_rate:.10f}" == "-1.7242353358"
     rng = _row(d, 1, "range")
     assert f"{rng['value'] * 1e9:.5f}" == "2811436.10547" and rng["unit"] == "s"
@@ -66,8 +68,9 @@ def test_doppler_utdf_matches_astro_utdf(shared_data):
     d = utdf.read(shared_data / "utdf/doppler.utdf")
     assert set(d.table["observable"]) == {"doppler_2way"}  # validity 0x02, zero range and angles
     dop = _row(d, 1, "doppler_2way")
-    assert dop["doppler_count"] == 43701446204 and f"{dop['value']:.3f}" == "40131.725"
-    range_rate = -C_KM_S / (2 * dop["uplink_hz"] * dop["transponder_ratio"]) * dop["value"]
+    assert dop["doppler_count"] == 43701446204 and f"{dop['doppler_shift_hz']:.3f}" == "40131.725"
+    assert dop["value"] == -dop["doppler_shift_hz"]
+    range_rate = C_KM_S / (2 * dop["uplink_hz"] * dop["transponder_ratio"]) * dop["value"]  # DSN: F = 2 M f rdot / c
     assert range_rate == pytest.approx(-2.70363808094889, rel=1e-14)
     assert _unix(dop["epoch"]) == 1260236511  # Tue Dec  8 01:41:51 2009
     assert (dop["data_interval_s"], dop["validity"], dop["band_code"]) == (256, 2, 0)
@@ -129,7 +132,8 @@ def test_fixture_made_by_the_writer():
     assert rng * 1e9 == pytest.approx(9876543210, abs=1e-6)
     dop = t[t["observable"] == "doppler_2way"]
     assert np.isnan(dop["value"].iloc[0])
-    np.testing.assert_allclose(dop["value"].iloc[1:], 26.0, atol=1e-9)
+    np.testing.assert_allclose(dop["doppler_shift_hz"].iloc[1:], 26.0, atol=1e-9)  # shift set by the cases
+    np.testing.assert_allclose(dop["value"].iloc[1:], -26.0, atol=1e-9)
     np.testing.assert_array_equal(dop["count_time"].iloc[1:], [1.0, 0.5])
     assert (t["tracker_type"] == 9).all() and (d.meta["records"]["router"] == "??").all()
 
