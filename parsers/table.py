@@ -40,6 +40,31 @@ COLUMNS: dict[str, tuple[str, str]] = {
     "flags": ("int64", "bitmask of edit reasons (see odpipe.preprocess.flags); 0 = used"),
 }
 
+# Columns that stages and readers add beside the contract's (name -> meaning). A
+# reader may add more of its format's own; each reader's docstring lists them.
+STAGE_COLUMNS: dict[str, str] = {
+    "elevation_rx": "rad; elevation of the spacecraft at the receiving station (odpipe.pipeline.geometry)",
+    "azimuth_rx": "rad; azimuth from north through east at the receiving station",
+    "rtlt_s": "s; round-trip light time (geometry), for the uplink leg of media and ramp look-ups",
+    "tropo_m": "m; troposphere correction: path delay (range) or its change over the count (Doppler)",
+    "iono_m": "m; ionosphere correction, same meaning (phase advance: opposite sign on Doppler)",
+    "media_m": "m; tropo_m + iono_m, entered into the computed value by the measurement models",
+    "media_ru": "RU; media_m of range rows in range units",
+    "media_source": "which file:line and card, or model, gave the downlink leg",
+    "media_source_up": "the same for the uplink leg",
+    "media_note": "why a fallback was used (no coverage, below horizon, unknown station)",
+    "source_records": "records of the raw rows a compressed row was made from",
+    "record_first": "first raw record of a compressed row",
+    "record_last": "last raw record of a compressed row",
+    "n_samples": "number of raw samples in a compressed row",
+    "range_modulus_ru": "RU; ambiguity modulus of ODF sequential range (range_modulus in TRK-2-34)",
+    "validity": "format validity code (ODF: 0 good); non-zero rows are flagged INVALID by editing",
+    "doppler_shift_hz": "Hz; UTDF's own signed Doppler shift (value = -shift, the DSN convention)",
+    "spacecraft_2": "second spacecraft of a crosslink row",
+}
+"""Sign convention: every ``doppler_*`` value is positive when the spacecraft
+recedes (Moyer, DSN), whatever the source format's own sign."""
+
 
 def empty(extra: dict[str, str] | None = None) -> pd.DataFrame:
     """An empty TrackingTable with the contract's dtypes (plus ``extra`` columns)."""
