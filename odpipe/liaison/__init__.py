@@ -1,0 +1,11 @@
+"""LiAISON crosslink navigation scenarios reproducing the seed studies.
+
+* :mod:`.orbits` - halo orbits by period, lunar orbiter (CRTBP);
+* :mod:`.crosslink` - two-spacecraft CRTBP crosslink problem for the fit;
+* :mod:`.pair` - one experiment: simulation, Monte Carlo trial, CRLB, Gramian;
+* :mod:`.turan` - scenario 2 (Turan et al.: range-only vs range-rate-only);
+* :mod:`.baseline` - scenario 1 (Fujimoto et al. sec. 2.1: GEO + L1 halo);
+* :mod:`.report` - tables and convergence plots of a scenario run.
+
+Run with ``odpipe liaison runs/liaison_X.toml -o DIR``.
+"""
