@@ -1,0 +1,75 @@
+"""Tracking passes and sample epochs from visibility and cadence rules.
+
+A network rule (:class:`odpipe.simulate.case.Network`) tracks on days
+``offset_days + k * every_days`` after the case start. On a tracking day the
+longest run of the spacecraft above the elevation mask (60-s grid, elevation
+from the measurement models) holds the passes: one pass centred on the
+culmination, or several of ``pass_s`` spread from rise to set. Inside a pass,
+Doppler intervals of ``doppler_count_s`` are contiguous and tagged at their end;
+range samples every ``range_step_s`` at reception.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from odpipe.measurements import compute
+from parsers.table import build
+
+GRID_S = 60
+NS = 1_000_000_000
+
+
+class StateOnly:
+    """A trajectory seen as a reference ephemeris (state and centre, no STM): the models give values only."""
+
+    def __init__(self, trajectory):
+        self.center = trajectory.center
+        self.state = trajectory.state
+
+
+def elevation(traj, setup, station: str, spacecraft: str, epochs: np.ndarray) -> np.ndarray:
+    """Elevation (rad) of the spacecraft seen from ``station`` at reception times ``epochs`` (UTC)."""
+    rows = build(epochs.size, epoch=epochs, observable="angle_el", unit="rad", station_rx=station,
+                 station_tx=station, spacecraft=spacecraft, tag="receive", count_time=0.0)
+    return compute(rows, {spacecraft: StateOnly(traj)}, setup).value
+
+
+def passes(traj, setup, net, spacecraft: str, start: np.datetime64, end: np.datetime64) -> list[tuple]:
+    """Pass windows [(start, end) datetime64[ns]] of one network rule."""
+    mask = np.radians(net.mask_deg)
+    out = []
+    day = np.timedelta64(86400 * NS, "ns")
+    k = 0
+    while True:
+        d0 = start + np.timedelta64(int((net.offset_days + k * net.every_days) * 86400 * NS), "ns")
+        k += 1
+        if d0 >= end:
+            return out
+        grid = np.arange(d0, min(d0 + day, end), np.timedelta64(GRID_S * NS, "ns"))
+        up = elevation(traj, setup, net.station, spacecraft, grid) > mask
+        if not up.any():
+            continue
+        edges = np.flatnonzero(np.diff(np.concatenate([[0], up.astype(int), [0]])))
+        runs = edges.reshape(-1, 2)
+        a, b = runs[np.argmax(runs[:, 1] - runs[:, 0])]
+        rise, set_ = grid[a], grid[b - 1]
+        length = np.timedelta64(int(net.pass_s * NS), "ns")
+        span = set_ - rise
+        if net.passes == 1:
+            mid = rise + (span - min(length, span)) // 2
+            out.append((mid, mid + min(length, span)))
+            continue
+        room = (span - net.passes * length) // (net.passes - 1) if span > net.passes * length else None
+        if room is None:
+            length = span // net.passes
+            room = np.timedelta64(0, "ns")
+        for j in range(net.passes):
+            s = rise + j * (length + room)
+            out.append((s, s + length))
+
+
+def sample_epochs(window: tuple, step_s: float) -> np.ndarray:
+    """Epochs step_s apart from window start + step_s to the window end (interval ends / receptions)."""
+    step = np.timedelta64(int(round(step_s * NS)), "ns")
+    return np.arange(window[0] + step, window[1] + np.timedelta64(1, "ns"), step)
