@@ -135,3 +135,23 @@ def test_transverse_empirical_acceleration_raises_semi_major_axis():
     expected = 2 * a0**1.5 * aT / np.sqrt(GM) * T  # first order in aT
     assert a1 - a0 == pytest.approx(expected, rel=1e-3)
     assert abs(s[2]) < 1e-6  # no out-of-plane motion from a transverse thrust
+
+
+def test_backward_arc_through_a_maneuver():
+    """Backward from the post-maneuver arc end: the impulse is removed, partials keep their meaning."""
+    tm, T = 5000.0, 16000.0
+    dv = np.array([10.0, -5.0, 3.0])
+    fm = ForceModel("earth", [ImpulsiveManeuver(tm, dv)], central_gm=GM)
+    xT = kepler(kepler(X0, tm) + np.r_[0, 0, 0, dv], T - tm)
+    back = propagate(xT, T, 0.0, fm, rtol=1e-13)
+    np.testing.assert_allclose(back.state(0.0)[0], X0, rtol=0, atol=1e-4)
+    np.testing.assert_allclose(back.state(tm)[0], kepler(X0, tm) + np.r_[0, 0, 0, dv], rtol=0, atol=1e-4)
+
+    def initial(dv_, tm_):
+        return kepler(kepler(xT, tm_ - T) - np.r_[0, 0, 0, dv_], -tm_)
+
+    sens = back.sensitivity(0.0)[0]
+    e = np.eye(3)[1] * 1e-3
+    np.testing.assert_allclose(sens[:, 1], (initial(dv + e, tm) - initial(dv - e, tm)) / 2e-3, rtol=1e-6, atol=1e-6)
+    fd_t = (initial(dv, tm + 0.01) - initial(dv, tm - 0.01)) / 0.02
+    np.testing.assert_allclose(sens[:, 3], fd_t, rtol=1e-5, atol=1e-6)

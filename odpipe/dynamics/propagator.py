@@ -4,7 +4,8 @@ Segments restart at maneuvers and at burn/empirical-batch boundaries. At an
 impulsive maneuver (ICRF delta-v, state independent) the velocity jumps by
 dv, the STM is continuous, the sensitivity to dv jumps by [0; I] and the
 sensitivity to the maneuver epoch by f(x-) - f(x+) (f = [v; a], the state
-derivative before and after the impulse); signs flip for backward arcs.
+derivative before and after the impulse). On backward arcs the impulse is
+removed (x- = x+ - dv), the dv jump is -[0; I] and the epoch jump f(x+) - f(x-).
 """
 
 from __future__ import annotations
@@ -78,7 +79,7 @@ def _apply_maneuver(y, t, k, dv, direction, model, params):
             if name.startswith(f"dv[{k}]."):
                 axis = name[-1]
                 if axis == "t":
-                    S[:, p] += direction * (before - after)
+                    S[:, p] += before - after  # f on the integration-incoming side minus outgoing side
                 else:
                     S[3 + "xyz".index(axis), p] += direction
     return y
