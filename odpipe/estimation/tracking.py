@@ -12,11 +12,15 @@ the start of the interval as the protocol requires.
 Registry conventions: the state is ``<sc>.x .. <sc>.vz`` (m, m/s, ICRF about the
 force model's centre); every force-model parameter ``p`` registered as
 ``<sc>.<p>`` (e.g. ``A.srp_scale``, ``A.dv[0].x``) is estimated. Stochastic
-(batch) accelerations are not mapped by this adapter.
+accelerations ``<sc>.acc_R|T|N`` (registry kind ``stochastic``) are added by the
+adapter as one :class:`~odpipe.dynamics.forces.EmpiricalRTN` batch spanning the
+interval with the registry's current values (the force model given must have
+no EmpiricalRTN of its own).
 """
 
 from __future__ import annotations
 
+from dataclasses import replace
 from typing import Callable
 
 import numpy as np
@@ -55,14 +59,28 @@ class TrackingProblem:
         self.i_state = np.array([registry.index(f"{spacecraft}.{a}") for a in STATE_AXES])
         self.bias_index = (np.full(len(rows), -1) if bias_index is None
                            else np.asarray(bias_index, int))
+        self.i_acc = np.array([registry.index(f"{spacecraft}.acc_{a}") for a in "RTN"
+                               if f"{spacecraft}.acc_{a}" in registry.names], int)
+        if self.i_acc.size not in (0, 3):
+            raise ValueError("stochastic accelerations need all of acc_R, acc_T, acc_N")
 
     def _flow(self, t0, x0, t_end):
         """Forward trajectory from ta = t0 - margin, d x(ta)/d x(t0), d x(ta)/d p, params."""
+        from odpipe.dynamics.forces import EmpiricalRTN
         from odpipe.dynamics.propagator import propagate
 
         fm = self.force_model(x0)
         names = set(self.registry.names)
         params = [p for p in fm.parameter_names() if f"{self.sc}.{p}" in names]
+        cols = [self.registry.index(f"{self.sc}.{p}") for p in params]
+        if self.i_acc.size:
+            if fm.of_type(EmpiricalRTN):
+                raise ValueError("the force model must not carry its own EmpiricalRTN")
+            lo, hi = min(t0 - self.margin, t0), max(t_end, t0) + 1.0
+            fm = replace(fm, components=list(fm.components)
+                         + [EmpiricalRTN(np.array([[lo, hi, *x0[self.i_acc]]]))])
+            params += ["emp[0].R", "emp[0].T", "emp[0].N"]
+            cols += list(self.i_acc)
         s0 = x0[self.i_state]
         if self.margin > 0:
             ta = t0 - self.margin
@@ -72,8 +90,7 @@ class TrackingProblem:
         else:
             ta, sa, Phi_b, S_b = t0, s0, np.eye(6), np.zeros((6, len(params)))
         fwd = propagate(sa, ta, t_end, fm, params=params, rtol=self.rtol)
-        cols = np.array([self.registry.index(f"{self.sc}.{p}") for p in params], int)
-        return fwd, Phi_b, S_b, cols
+        return fwd, Phi_b, S_b, np.array(cols, int), params
 
     def _to_registry(self, Phi_f, S_f, Phi_b, S_b, cols):
         """d x(t) / d (registry vector at t0), rows of the state: (m, 6, n)."""
@@ -84,7 +101,7 @@ class TrackingProblem:
         return D
 
     def transition(self, t0, t1, x0):
-        fwd, Phi_b, S_b, cols = self._flow(t0, x0, t1)
+        fwd, Phi_b, S_b, cols, _ = self._flow(t0, x0, t1)
         D = self._to_registry(fwd.stm(t1), fwd.sensitivity(t1), Phi_b, S_b, cols)
         Phi = np.eye(len(self.registry))
         Phi[self.i_state] = D[0]
@@ -95,7 +112,7 @@ class TrackingProblem:
     def predict(self, t0, x0, rows):
         from odpipe.measurements import compute
 
-        fwd, Phi_b, S_b, cols = self._flow(t0, x0, float(self.times[rows].max()) + 1.0)
+        fwd, Phi_b, S_b, cols, params = self._flow(t0, x0, float(self.times[rows].max()) + 1.0)
         ev = compute(self.rows.iloc[rows], {self.sc: fwd}, self.setup)
         bad = ~np.isfinite(ev.value)
         if bad.any():
@@ -108,14 +125,10 @@ class TrackingProblem:
             dyn = ev.partials.get(f"dynamic:{self.sc}")
             if dyn is not None:
                 names = ev.names[f"dynamic:{self.sc}"]
-                H[:, cols] += dyn[:, [names.index(p) for p in self._param_names(cols)]]
+                H[:, cols] += dyn[:, [names.index(p) for p in params]]
         z = ev.value.copy()
         b = self.bias_index[rows]
         has = b >= 0
         z[has] += x0[b[has]]
         H[np.flatnonzero(has), b[has]] += 1.0
         return z, H
-
-    def _param_names(self, cols):
-        prefix = len(self.sc) + 1
-        return [self.registry.names[c][prefix:] for c in cols]
