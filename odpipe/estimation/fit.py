@@ -13,7 +13,13 @@ registry coordinates (the full parameter vector, state and parameters alike):
 The grid holds the arc ends, a regular spacing (``block`` s), the batch
 boundaries of every stochastic parameter and any extra epochs (maneuvers). At a
 batch boundary the SRIF applies ``p+ = m p + w``; the measurements of each grid
-interval are absorbed in one Householder update.
+interval are absorbed in one Householder update, after an innovation k-sigma
+test against the filter's prediction.
+
+Each iteration is one filter pass and one smoother pass about a reference; the
+next reference starts from the smoothed epoch vector and takes the smoothed
+stochastic values after each batch boundary. The fit stops when every epoch
+correction is below ``tol_dx`` of its sigma and the post-fit RMS is stable.
 """
 
 from __future__ import annotations
