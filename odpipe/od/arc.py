@@ -21,7 +21,7 @@ import numpy as np
 import pandas as pd
 
 from odpipe.dynamics.forces import ForceModel, SolarRadiationPressure
-from odpipe.estimation.fit import EDIT_INNOVATION, FitOptions, Observations, Solution, fit
+from odpipe.estimation.fit import EDIT_INNOVATION, FitOptions, Observations, Solution, build_grid, fit
 from odpipe.estimation.maneuvers import maneuver_table
 from odpipe.estimation.registry import GaussMarkov, ParameterRegistry
 from odpipe.measurements import MeasurementSetup
@@ -159,10 +159,13 @@ def fit_arc(table: pd.DataFrame, setup: ArcSetup) -> ArcSolution:
     """
     rows, times = select_rows(table, setup)
     reg = build_registry(setup, rows)
+    options = FitOptions(max_iter=setup.max_iter, block=setup.block, edit_k=tuple(setup.edit_k),
+                         reweight=setup.reweight)
+    grid, _ = build_grid(reg, setup.start, setup.end, options.block, options.extra_epochs)
 
     def problem_for(r, t):
         return TrackingProblem(reg, r, t, {setup.spacecraft: setup.force_model}, setup.measurements,
-                               setup.start, setup.end, setup.lookback)
+                               setup.start, setup.end, setup.lookback, epochs=grid)
 
     problem = problem_for(rows, times)
     _, to_los, status = problem.reference(reg.apriori)
@@ -173,8 +176,6 @@ def fit_arc(table: pd.DataFrame, setup: ArcSetup) -> ArcSolution:
     sig = used["observable"].map(setup.data_sigma).to_numpy(float) / to_los[good]
     group = (used["observable"] + ":" + used["station_rx"].astype(str)).to_numpy(object)
     obs = Observations(times[good], used["value"].to_numpy(float), sig, group)
-    options = FitOptions(max_iter=setup.max_iter, block=setup.block, edit_k=tuple(setup.edit_k),
-                         reweight=setup.reweight)
     sol = fit(problem, obs, setup.start, setup.end, options)
     return _solution(setup, reg, problem, sol, rows, times, to_los, status)
 

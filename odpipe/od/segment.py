@@ -48,7 +48,7 @@ class SegmentTrajectory:
         self._back = propagate(self.x_start, a, a - lookback, force_model, with_stm=True,
                                params=list(params), rtol=rtol, atol=atol)
         self.n_eval = self._fwd.n_eval + self._back.n_eval
-        self._memo: dict = {}
+        self._memo: dict = {float(a): (self.x_start, np.eye(6), np.zeros((6, len(self.param_names))))}
 
     def _pieces(self, t):
         t = np.atleast_1d(np.asarray(t, float))
@@ -93,14 +93,15 @@ class SegmentTrajectory:
     def at(self, t: float) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         """(x, Phi, S) at one epoch, the state at ``a`` taken before its maneuver (Phi = I, S = 0).
 
-        Remembers the last few epochs: the filter asks for each grid epoch twice."""
+        Served from :meth:`preload` or remembered: the filter asks for each grid epoch twice."""
         t = float(t)
         if t not in self._memo:
-            if t == self.t0:
-                val = (self.x_start, np.eye(6), np.zeros((6, len(self.param_names))))
-            else:
-                val = (self.state(t)[0], self.stm(t)[0], self.sensitivity(t)[0])
-            if len(self._memo) > 4:
-                self._memo.pop(next(iter(self._memo)))
-            self._memo[t] = val
+            self.preload([t])
         return self._memo[t]
+
+    def preload(self, epochs) -> None:
+        """Evaluate (x, Phi, S) at ``epochs`` inside the segment in one vectorized pass."""
+        ts = np.asarray([t for t in np.atleast_1d(epochs) if self.t0 < t <= self.t1 and t not in self._memo], float)
+        if ts.size:
+            x, Phi, S = self.state(ts), self.stm(ts), self.sensitivity(ts)
+            self._memo.update({float(t): (x[i], Phi[i], S[i]) for i, t in enumerate(ts)})
