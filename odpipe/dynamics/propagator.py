@@ -16,7 +16,7 @@ import numpy as np
 
 from odpipe.dynamics.dop853 import integrate
 from odpipe.dynamics.forces import ForceModel, compile_model
-from odpipe.dynamics.rhs import acceleration, rhs
+from odpipe.dynamics.rhs import acceleration  # also registers the orbit right-hand side
 from odpipe.dynamics.trajectory import Trajectory, TrajectorySet
 
 
