@@ -1,0 +1,70 @@
+"""Scenario products: paper-vs-odpipe tables (CSV + Markdown) and convergence plots (PNG).
+
+All files are written atomically into the run directory.
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+import pandas as pd
+
+from odpipe.products.atomic import atomic_path, write_text
+
+
+def _cell(v) -> str:
+    if isinstance(v, (float, np.floating)):
+        if not np.isfinite(v):
+            return "-"
+        return f"{v:.3g}" if abs(v) >= 1e-3 or v == 0 else f"{v:.2e}"
+    return str(v)
+
+
+def markdown_table(df: pd.DataFrame) -> str:
+    """GitHub Markdown table of a DataFrame (floats to 3 significant digits)."""
+    lines = ["| " + " | ".join(map(str, df.columns)) + " |",
+             "|" + "---|" * len(df.columns)]
+    lines += ["| " + " | ".join(_cell(v) for v in row) + " |" for row in df.itertuples(index=False)]
+    return "\n".join(lines) + "\n"
+
+
+def write_table(out: Path, name: str, df: pd.DataFrame) -> str:
+    """Write NAME.csv and return the Markdown rendering."""
+    with atomic_path(Path(out) / f"{name}.csv") as tmp:
+        df.to_csv(tmp, index=False)
+    return markdown_table(df)
+
+
+def write_markdown(out: Path, title: str, sections: list[tuple[str, str]]) -> Path:
+    """report.md: a title and (heading, body) sections."""
+    text = f"# {title}\n\n" + "\n".join(f"## {h}\n\n{b}\n" for h, b in sections)
+    return write_text(Path(out) / "report.md", text)
+
+
+def plot_convergence(out: Path, name: str, panels: list[dict], ylabel: str, ncols: int = 2) -> Path:
+    """One log-scale panel per dict {title, t_days, curves: [(label, values, style)]}, ncols per row;
+    a style's 't' overrides the panel's t_days for that curve."""
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    nrows = -(-len(panels) // ncols)
+    fig, axes = plt.subplots(nrows, ncols, figsize=(5.0 * ncols, 3.3 * nrows), squeeze=False)
+    for ax, p in zip(axes.ravel(), panels):
+        for label, y, style in p["curves"]:
+            ax.semilogy(p["t_days"] if "t" not in style else style["t"], y,
+                        **{k: v for k, v in style.items() if k != "t"}, label=label)
+        ax.set_title(p["title"], fontsize=9)
+        ax.set_xlabel("days")
+        ax.grid(True, which="both", alpha=0.3)
+    for row in axes:
+        row[0].set_ylabel(ylabel)
+    axes[0][-1].legend(fontsize=7)
+    fig.tight_layout()
+    path = Path(out) / f"{name}.png"
+    with atomic_path(path) as tmp:
+        fig.savefig(tmp, dpi=110, format="png")
+    plt.close(fig)
+    return path
