@@ -6,7 +6,7 @@ iterated filter-smoother fit, maneuver products.
     sol = fit(problem, Observations(t, value, sigma, group), t0, t1, FitOptions())
 
 ``problem`` satisfies :class:`~odpipe.estimation.fit.Problem`: ``transition`` and
-``predict`` in registry coordinates (see :mod:`.fit`); :class:`.tracking.TrackingProblem`
+``predict`` in registry coordinates (see :mod:`.fit`); :class:`odpipe.od.TrackingProblem`
 builds one from odpipe.dynamics and odpipe.measurements.
 """
 
@@ -17,9 +17,8 @@ from .registry import GaussMarkov, Parameter, ParameterRegistry
 from .smoother import smooth
 from .solution import Solution
 from .srif import SRIF, Gaussian
-from .tracking import TrackingProblem, observations_from_rows
 
 __all__ = ["BatchSolution", "batch_least_squares", "EDIT_INNOVATION", "OUTSIDE_ARC", "FitOptions",
            "Observations", "Problem", "fit", "ManeuverFinding", "detect_maneuvers",
            "maneuver_table", "GaussMarkov", "Parameter", "ParameterRegistry", "smooth",
-           "Solution", "SRIF", "Gaussian", "TrackingProblem", "observations_from_rows"]
+           "Solution", "SRIF", "Gaussian"]
