@@ -6,7 +6,8 @@ Encodings (what the project's readers decode back):
   format 6 (Doppler counts): per pass a record at the first count start (count 0) and one per
   interval end, ``dop_cnt`` = cumulative cycles of (``dop_cnt_bias_freq`` + Doppler), so
   Doppler (Hz) = diff(count) / count_time - bias; format 9: the uplink ramps.
-* UTDF: destruct Doppler (validity bit 6) count = round((240 MHz + 1000 Doppler) * interval),
+* UTDF: destruct Doppler (validity bit 6) count = round((240 MHz - 1000 Doppler) * interval) (shift
+  positive approaching),
   range as round-trip delay in 1/256 ns; pad ids from the case, spacecraft id as SIC.
 """
 
@@ -89,7 +90,8 @@ def utdf_records(table: pd.DataFrame, pad: int, sc: int) -> pd.DataFrame:
     is_range = (table["observable"] == "range").to_numpy()
     ct = table["count_time"].to_numpy()
     value = table["value"].to_numpy()
-    doppler = np.where(is_range, 0, np.rint((utdf.DOPPLER_BIAS_HZ + 1000.0 * value) * np.where(is_range, 0, ct)))
+    # the format counts bias + M * shift, the shift positive approaching (minus the DSN-convention Doppler)
+    doppler = np.where(is_range, 0, np.rint((utdf.DOPPLER_BIAS_HZ - 1000.0 * value) * np.where(is_range, 0, ct)))
     rng = np.where(is_range, np.rint(value * 256e9), 0)
     interval = np.where(is_range, 0, np.rint(ct)).astype(np.int64)
     return pd.DataFrame({

@@ -1,0 +1,134 @@
+"""Simulator (issue 10): files read back by the project's readers, models reproduce values, noise, media, mask, seeds."""
+
+from __future__ import annotations
+
+import hashlib
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from odpipe.measurements import MeasurementSetup, compute
+from odpipe.media.apply import calibrate
+from odpipe.media.model import MediaModel
+from parsers import trk234, utdf
+from parsers.trk223 import read_trk223
+
+CASE = Path(__file__).resolve().parents[1] / "runs" / "artemis_p2_like.toml"
+DAYS = 2.5
+
+
+@pytest.fixture(scope="module")
+def sim(tmp_path_factory):
+    from odpipe.simulate import run_case
+
+    out = tmp_path_factory.mktemp("sim")
+    paths, truth, obs = run_case(CASE, out, days=DAYS)
+    return paths, truth, obs
+
+
+def _setup(obs):
+    from odpipe.environment.ephemeris import Ephemeris
+    from odpipe.environment.stations import StationCatalog
+    from odpipe.frames.earth import gcrs_to_itrs
+    from odpipe.simulate.run import STATIONS_CSV
+    from parsers.ramps import RampStore
+
+    return MeasurementSetup(Ephemeris.open("de421"), StationCatalog.default().with_csv(STATIONS_CSV),
+                            ramps=RampStore(obs.ramps), gcrs_to_itrs=gcrs_to_itrs)
+
+
+def test_case_has_every_network_kind(sim):
+    _, _, obs = sim
+    t = obs.table
+    assert {"DSS-24", "DSS-34", "BGS"} <= set(t["station_rx"])
+    assert {"range", "doppler_2way"} == set(t["observable"])
+
+
+def test_trk234_reads_back(sim):
+    paths, _, obs = sim
+    d = trk234.read(paths["trk234"])
+    t = obs.table[obs.table["station_rx"].str.startswith("DSS-")]
+    rng = d.table[d.table["observable"] == "range"].reset_index(drop=True)
+    want = t[t["observable"] == "range"].reset_index(drop=True)
+    assert np.array_equal(rng["value"].to_numpy(), want["value"].to_numpy())          # f8: bit for bit
+    assert np.array_equal(rng["epoch"].to_numpy(), want["epoch"].to_numpy())
+    assert (rng["station_rx"] == want["station_rx"]).all()
+    dop = d.table[d.table["observable"] == "doppler_count_2way"]
+    got = []
+    for _, g in dop.groupby(["station_rx", dop["count_time"].eq(0).cumsum()]):
+        c, ct = g["value"].to_numpy(), g["count_time"].to_numpy()[1:]
+        got.append(np.diff(c) / ct - g["doppler_bias_hz"].to_numpy()[1:])
+    dw = t[t["observable"] == "doppler_2way"].sort_values(["pass_id", "epoch"])
+    # cumulative counts of ~1e10 cycles in f8 (2e-6 cycles) over 60 s: 1e-7 Hz
+    np.testing.assert_allclose(np.concatenate(got), dw["value"].to_numpy(), rtol=0, atol=1e-6)
+    ramps = d.ramps.sort_values("start").reset_index(drop=True)
+    np.testing.assert_array_equal(ramps["freq_hz"].to_numpy(), obs.ramps.sort_values("start")["freq_hz"].to_numpy())
+
+
+def test_utdf_reads_back(sim):
+    paths, _, obs = sim
+    d = utdf.read(paths["utdf:BGS"])
+    want = obs.table[obs.table["station_rx"] == "BGS"].reset_index(drop=True)
+    got = d.table.reset_index(drop=True)
+    assert (got["observable"] == "doppler_2way").all() and len(got) == len(want)
+    # integer cycles over 10 s at M = 1000: half a cycle of rounding = 5e-5 Hz
+    assert np.abs(got["value"].to_numpy() - want["value"].to_numpy()).max() <= 5e-5 + 1e-9
+    assert np.array_equal(got["epoch"].to_numpy(), want["epoch"].to_numpy())
+    assert (got["count_time"] == want["count_time"]).all()
+    assert utdf.encode(d.meta["records"]) == paths["utdf:BGS"].read_bytes()
+
+
+def test_noise_free_values_recomputed_from_the_truth(sim):
+    paths, truth, obs = sim
+    from odpipe.simulate.schedule import StateOnly
+
+    t = obs.table.drop(columns=["media_m"])
+    ev = compute(t, {t["spacecraft"].iloc[0]: StateOnly(truth.trajectory)}, _setup(obs))
+    np.testing.assert_array_equal(ev.value, obs.errors["model"].to_numpy())
+    e = obs.errors
+    rebuilt = e["model"] + e["media"] + e["noise"] + e["bias"] + e["spin"]
+    np.testing.assert_allclose(rebuilt, obs.table["value"], rtol=1e-15, atol=1e-9)
+
+
+def test_noise_sigma_within_chi2_bounds(sim):
+    _, _, obs = sim
+    from scipy.stats import chi2
+
+    e = obs.errors
+    for obs_name in ("range", "doppler_2way"):
+        sel = (obs.table["observable"] == obs_name).to_numpy()
+        for st in obs.table.loc[sel, "station_rx"].unique():
+            m = sel & (obs.table["station_rx"] == st).to_numpy()
+            z = (e["noise"] * e["to_los"] / e["sigma_los"]).to_numpy()[m]
+            n = z.size
+            s2 = np.sum(z**2)
+            assert chi2.ppf(0.0005, n) < s2 < chi2.ppf(0.9995, n), (obs_name, st, n, s2 / n)
+
+
+def test_tro_calibration_removes_the_added_media(sim):
+    paths, _, obs = sim
+    cal = read_trk223(paths["tro"])
+    t = obs.table.drop(columns=["media_m"])
+    from odpipe.environment.stations import StationCatalog
+
+    catalog = StationCatalog.default().with_csv(paths["stations"])
+    out, _ = calibrate(t, MediaModel(cal), ramps=obs.ramps, catalog=catalog, order=None)
+    np.testing.assert_allclose(np.nan_to_num(out["media_m"]), np.nan_to_num(obs.table["media_m"]), atol=1e-12)
+    dsn = t["station_rx"].str.startswith("DSS").to_numpy()
+    assert out["media_source"][dsn].str.contains(".TRO").all()
+    assert np.nanmax(np.abs(obs.errors["media"])) > 0      # the delays were really added
+
+
+def test_every_sample_above_the_mask(sim):
+    _, _, obs = sim
+    assert (obs.table["elevation_rx"] >= np.radians(10.0)).all()
+
+
+def test_same_seed_same_bytes(sim, tmp_path):
+    from odpipe.simulate import run_case
+
+    paths, _, _ = sim
+    again, _, _ = run_case(CASE, tmp_path, days=DAYS)
+    for role in ("trk234", "utdf:BGS", "tro", "maneuvers", "spk"):
+        assert hashlib.sha256(paths[role].read_bytes()).digest() == hashlib.sha256(again[role].read_bytes()).digest(), role
