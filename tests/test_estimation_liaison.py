@@ -1,8 +1,8 @@
 """LiAISON baseline in the Earth-Moon CRTBP (seed 000, section 2.1).
 
-A spacecraft in an Earth-Moon L1 halo (differentially corrected here) and one at
-GEO, tracked only by each other: instantaneous relative range (1 m) and
-range-rate (1 cm/s) every 100 s. A priori 100 m / 1 cm/s per axis for both, truth
+A spacecraft in an Earth-Moon L1 halo (odpipe.liaison.orbits.correct_halo) and
+one at GEO, tracked only by each other (odpipe.liaison.crosslink.CrosslinkProblem):
+instantaneous relative range (1 m) and range-rate (1 cm/s) every 100 s. A priori 100 m / 1 cm/s per axis for both, truth
 drawn from it. Dynamics: odpipe.dynamics.crtbp (GM Earth 398,600.4415 km^3/s^2,
 Moon 4,902.80 km^3/s^2). The paper's state-noise compensation (1e-13 and
 1e-14 m/s^2) moves a state by < 0.03 m in 8 days and is left out here.
@@ -12,38 +12,16 @@ to the metre level within about a week.
 
 import numpy as np
 import pytest
-from scipy.optimize import brentq
 
-from odpipe.dynamics.crtbp import EarthMoonUnits, crtbp_rhs, propagate_crtbp
+from odpipe.dynamics.crtbp import EarthMoonUnits, propagate_crtbp
 from odpipe.estimation.fit import FitOptions, Observations, fit
 from odpipe.estimation.registry import ParameterRegistry
-from odpipe.estimation.testing import range_and_rate
+from odpipe.liaison.crosslink import CrosslinkProblem, crosslink_rows
+from odpipe.liaison.orbits import correct_halo
 
 U = EarthMoonUnits(gm1=3.986004415e14, gm2=4.90280e12)
 MU, T, L = U.mu, U.time, U.length
 DAY = 86400.0
-D_SI = np.diag([L] * 3 + [L / T] * 3)
-
-
-def halo_l1(x0=0.8234, z0=0.01, vy0=0.13):
-    """Northern L1 halo through (x0, 0, z0) with y-velocity vy0: correct (z0, vy0) so that
-    the half-period x-z plane crossing is perpendicular (vx = vz = 0)."""
-    s = np.array([x0, 0, z0, 0, vy0, 0.0])
-    for _ in range(40):
-        tr = propagate_crtbp(s, 0.0, 3.5, MU)
-        ts = np.linspace(0.3, 3.5, 400)
-        y = tr.state(ts)[:, 1]
-        i = np.flatnonzero(np.sign(y[:-1]) != np.sign(y[1:]))[0]
-        tc = brentq(lambda t: tr.state(t)[0, 1], ts[i], ts[i + 1], xtol=1e-14)
-        X, Phi = tr.state(tc)[0], tr.stm(tc)[0]
-        if np.max(np.abs(X[[3, 5]])) < 1e-12:
-            return s, 2 * tc
-        dX = np.empty(6)
-        crtbp_rhs(0.0, X, np.array([MU]), dX)
-        J = Phi[np.ix_([3, 5], [2, 4])] - np.outer(dX[[3, 5]], Phi[1, [2, 4]]) / dX[1]
-        dp = np.linalg.solve(J, -X[[3, 5]])
-        s[[2, 4]] += dp * min(1.0, 0.01 / np.max(np.abs(dp)))
-    raise RuntimeError("halo correction did not converge")
 
 
 def geo_state():
@@ -55,41 +33,9 @@ def geo_state():
     return np.concatenate([pos, v_circ - np.cross([0, 0, w], [rho, 0, 0])])
 
 
-class LiaisonProblem:
-    """Two CRTBP spacecraft, registry [halo(6), geo(6)] in SI rotating-frame units."""
-
-    def __init__(self, registry, times, kind):
-        self.registry, self.times, self.kind = registry, times, kind
-
-    @staticmethod
-    def _flow(x_si, t0, times):
-        tr = propagate_crtbp(U.from_si(x_si), t0 / T, max(times) / T, MU)
-        tq = np.asarray(times) / T
-        X = U.to_si(tr.state(tq))
-        Phi = D_SI @ tr.stm(tq) @ np.linalg.inv(D_SI)
-        return X, Phi
-
-    def transition(self, t0, t1, x0):
-        Phi = np.eye(12)
-        x1 = x0.copy()
-        for s in (slice(0, 6), slice(6, 12)):
-            X, P = self._flow(x0[s], t0, [t1])
-            x1[s], Phi[s, s] = X[0], P[0]
-        return x1, Phi
-
-    def predict(self, t0, x0, rows):
-        t = self.times[rows]
-        Xh, Ph = self._flow(x0[:6], t0, t)
-        Xg, Pg = self._flow(x0[6:], t0, t)
-        z, dz = range_and_rate(Xh, Xg[:, :3], Xg[:, 3:], self.kind[rows])
-        H = np.concatenate([np.einsum("mj,mjk->mk", dz, Ph),
-                            -np.einsum("mj,mjk->mk", dz, Pg)], axis=1)
-        return z, H
-
-
 @pytest.fixture(scope="module")
 def liaison():
-    halo_nd, period = halo_l1()
+    halo_nd, period = correct_halo(0.8234, 0.01, 0.13, MU)     # northern L1 halo, Az ~ 10,000 km
     assert 11.0 < period * T / DAY < 13.0                     # ~12-day L1 halo
     x_true = np.concatenate([U.to_si(halo_nd), geo_state()])
     rng = np.random.default_rng(2012)
@@ -104,11 +50,10 @@ def liaison():
     Xg = U.to_si(propagate_crtbp(U.from_si(x_true[6:]), 0.0, arc / T, MU).state(t_obs / T))
     t = np.repeat(t_obs, 2)
     kind = np.tile([0, 1], t_obs.size)
-    z, _ = range_and_rate(np.repeat(Xh, 2, 0), np.repeat(Xg[:, :3], 2, 0),
-                          np.repeat(Xg[:, 3:], 2, 0), kind)
+    z, _ = crosslink_rows(np.repeat(Xh, 2, 0), np.repeat(Xg, 2, 0), t, kind)
     sigma = np.where(kind == 0, 1.0, 0.01)
     z = z + rng.normal(size=z.size) * sigma
-    prob = LiaisonProblem(reg, t, kind)
+    prob = CrosslinkProblem(reg, U, t, kind)
     sol = fit(prob, Observations(t, z, sigma, kind), 0.0, arc,
               FitOptions(block=3 * 3600.0, max_iter=4))
     truth = np.concatenate([Xh, Xg], axis=1)
