@@ -3,8 +3,9 @@
 * Halo orbits: symmetric periodic orbits through the x-z plane, found by
   differential correction to a perpendicular half-period crossing (vx = vz = 0
   at y = 0) with z0 fixed, and picked out of the family by period (secant on z0).
-* Lunar orbiter: a Keplerian ellipse about the Moon of given period, set in the
-  rotating frame at t = 0 (Moon-centred axes parallel to the rotating axes).
+* Keplerian orbiters (lunar orbiter, GEO): an ellipse of given period about the
+  Moon or the Earth, set in the rotating frame at t = 0 (primary-centred axes
+  parallel to the rotating axes).
 """
 
 from __future__ import annotations
@@ -81,19 +82,21 @@ def halo_by_period(period: float, x0: float, vy0: float, z_start: float, z_stop:
     return correct_halo(left[0], z0, left[4], mu, hold="z")
 
 
-def lunar_orbiter(period: float, ecc: float, inc: float, mu: float, raan: float = 0.0,
-                  argp: float = 0.0, true_anomaly: float = 0.0) -> np.ndarray:
-    """Rotating-frame nondimensional state of a Moon-centred Keplerian orbit (angles in rad)."""
-    a = (mu * (period / (2 * np.pi)) ** 2) ** (1 / 3)
+def keplerian_orbit(period: float, ecc: float, inc: float, mu: float, raan: float = 0.0,
+                    argp: float = 0.0, true_anomaly: float = 0.0, primary: str = "moon") -> np.ndarray:
+    """Rotating-frame nondimensional state of a Keplerian orbit about 'moon' or 'earth'
+    (period nondimensional, angles in rad, two-body GM of the primary only)."""
+    gm, centre = (mu, 1 - mu) if primary == "moon" else (1 - mu, -mu)
+    a = (gm * (period / (2 * np.pi)) ** 2) ** (1 / 3)
     p = a * (1 - ecc**2)
     r = p / (1 + ecc * np.cos(true_anomaly))
     r_pf = r * np.array([np.cos(true_anomaly), np.sin(true_anomaly), 0.0])
-    v_pf = np.sqrt(mu / p) * np.array([-np.sin(true_anomaly), ecc + np.cos(true_anomaly), 0.0])
+    v_pf = np.sqrt(gm / p) * np.array([-np.sin(true_anomaly), ecc + np.cos(true_anomaly), 0.0])
     cO, sO, ci, si, cw, sw = np.cos(raan), np.sin(raan), np.cos(inc), np.sin(inc), np.cos(argp), np.sin(argp)
     R = np.array([[cO * cw - sO * sw * ci, -cO * sw - sO * cw * ci, sO * si],
                   [sO * cw + cO * sw * ci, -sO * sw + cO * cw * ci, -cO * si],
                   [sw * si, cw * si, ci]])
     r_in, v_in = R @ r_pf, R @ v_pf
-    pos = r_in + np.array([1 - mu, 0.0, 0.0])
+    pos = r_in + np.array([centre, 0.0, 0.0])
     vel = v_in - np.cross([0.0, 0.0, 1.0], r_in)       # inertial -> rotating (omega = 1)
     return np.concatenate([pos, vel])

@@ -27,7 +27,8 @@ class CrosslinkPair:
     <= arc (``first`` = 0 puts a sample at t = 0 too); kinds: data types per epoch (0 range,
     1 range-rate); sigma: noise per type (m, m/s); apriori: (pos m, vel m/s) filter sigma;
     error: (pos m, vel m/s) sigma of the drawn a priori error per component; block (s):
-    fit grid spacing; sigma_acc (m/s^2): state-noise compensation in the CRLB only."""
+    fit grid spacing; sigma_acc (m/s^2, per spacecraft): state-noise compensation in the
+    CRLB only; deviation: fixed a priori error (12,) instead of drawing it."""
 
     units: EarthMoonUnits
     x1: np.ndarray
@@ -41,7 +42,8 @@ class CrosslinkPair:
     block: float = 3 * 3600.0
     first: int = 1
     max_iter: int = 6
-    sigma_acc: float = 0.0
+    sigma_acc: tuple = (0.0, 0.0)
+    deviation: np.ndarray | None = None
 
     @property
     def epochs(self) -> np.ndarray:
@@ -92,7 +94,7 @@ class CrosslinkPair:
         Hs = H.reshape(t_ep.size, n, 12)
         Ws = W.reshape(t_ep.size, n)
         steps = np.diff(np.concatenate([[0.0], t_ep]))
-        Qs = None if self.sigma_acc == 0 else [snc_process_noise(h, [self.sigma_acc] * 2) for h in steps]
+        Qs = None if not any(self.sigma_acc) else [snc_process_noise(h, self.sigma_acc) for h in steps]
         return t_ep, crlb_history(self.p0(), Phis, Hs, Ws, Qs)
 
     def __call__(self, rng: np.random.Generator, index: int = 0) -> dict:
@@ -104,7 +106,8 @@ class CrosslinkPair:
         sig = self.sigma_rows(kind)
         z = z + rng.normal(size=z.size) * sig
         x_true = np.concatenate([self.x1, self.x2])
-        err0 = rng.normal(size=12) * np.tile(np.repeat(np.asarray(self.error, float), 3), 2)
+        err0 = (rng.normal(size=12) * np.tile(np.repeat(np.asarray(self.error, float), 3), 2)
+                if self.deviation is None else np.asarray(self.deviation, float))
         reg = ParameterRegistry()
         reg.add_state("sc1", x_true[:6] + err0[:6], *self.apriori)
         reg.add_state("sc2", x_true[6:] + err0[6:], *self.apriori)
@@ -112,7 +115,9 @@ class CrosslinkPair:
                   0.0, float(t[-1]), FitOptions(block=self.block, max_iter=self.max_iter))
         G1, G2, _, _ = self.truth(sol.grid)
         truth = np.concatenate([G1, G2], axis=1)
+        post = sol.residuals["postfit"].to_numpy()
         return {"grid": sol.grid, "filtered": sol.filtered_x - truth,
+                "postfit_rms": [float(np.sqrt(np.nanmean(post[kind == k] ** 2))) for k in self.kinds],
                 "smoothed": sol.smoothed_x - truth,
                 "filtered_sigma": np.sqrt(np.diagonal(sol.filtered_P, axis1=1, axis2=2)),
                 "converged": sol.converged, "iterations": len(sol.history)}

@@ -25,7 +25,7 @@ from odpipe.analysis.observability import gramian, observability_measures, snr_r
 from odpipe.dynamics.crtbp import jacobi_constant
 
 from .crosslink import RANGE, RANGE_RATE, units_from_mu
-from .orbits import halo_by_period, lunar_orbiter
+from .orbits import halo_by_period, keplerian_orbit
 from .pair import CrosslinkPair
 from .report import plot_convergence, write_markdown, write_table
 
@@ -47,7 +47,7 @@ def orbits(cfg, U):
                      for p in h["periods_tu"]]
     lo = cfg["lunar"]
     p = lo["period_days"] * DAY / U.time
-    out["lunar"] = (lunar_orbiter(p, lo["ecc"], np.radians(lo["inc_deg"]), U.mu,
+    out["lunar"] = (keplerian_orbit(p, lo["ecc"], np.radians(lo["inc_deg"]), U.mu,
                                   np.radians(lo.get("raan_deg", 0.0)), np.radians(lo.get("argp_deg", 0.0)),
                                   np.radians(lo.get("true_anomaly_deg", 0.0))), p)
     return out
@@ -98,7 +98,7 @@ def lunar_phase_band(cfg, U, cols, orb) -> dict:
             continue
         vals = []
         for nu in lo["phase_band_deg"]:
-            x = lunar_orbiter(period, lo["ecc"], np.radians(lo["inc_deg"]), U.mu,
+            x = keplerian_orbit(period, lo["ecc"], np.radians(lo["inc_deg"]), U.mu,
                               np.radians(lo.get("raan_deg", 0.0)), np.radians(lo.get("argp_deg", 0.0)),
                               np.radians(nu))
             vals.append(observability_row(replace(pair, x2=U.to_si(x))))
