@@ -1,7 +1,8 @@
 """Simulated DSN tracking of a known trajectory, for fits against truth (tests, benchmarks).
 
-Two-way Doppler (count-averaged, tagged at the interval end) and two-way
-range (metres, at reception) from each station while the spacecraft is above
+Two-way (or one-way, against ``setup.oscillators``) Doppler, count-averaged and
+tagged at the interval end, and two-way range (metres, at reception) from each
+station while the spacecraft is above
 an elevation mask, computed with the product's own measurement models on the
 truth trajectory, plus Gaussian noise and a constant range bias per pass.
 Noise and biases are given along the line of sight (m/s, m) and converted to
@@ -21,7 +22,8 @@ from parsers.table import build
 
 @dataclass(frozen=True)
 class TrackingPlan:
-    """What to simulate: stations, span (UTC datetime64), cadences (s), mask (rad), noise (LOS units)."""
+    """What to simulate: stations, span (UTC datetime64), cadences (s), mask (rad), noise (LOS units);
+    doppler: 'doppler_2way' or 'doppler_1way' (reference frequency ``uplink_hz``)."""
 
     stations: tuple
     start: np.datetime64
@@ -35,11 +37,14 @@ class TrackingPlan:
     uplink_hz: float = 7.16e9
     band: str = "X"
     spacecraft: str = "SC"
+    doppler: str = "doppler_2way"
 
 
 def _rows(n, plan, epoch, observable, station, unit, count, tag, pass_id):
-    return build(n, epoch=epoch, observable=observable, unit=unit, station_tx=station, station_rx=station,
-                 spacecraft=plan.spacecraft, tag=tag, count_time=count, band_up=plan.band, band_down=plan.band,
+    one_way = observable == "doppler_1way"
+    return build(n, epoch=epoch, observable=observable, unit=unit, station_tx="" if one_way else station,
+                 station_rx=station, spacecraft=plan.spacecraft, tag=tag, count_time=count,
+                 band_up="" if one_way else plan.band, band_down=plan.band,
                  uplink_hz=plan.uplink_hz, ramped=False, transponder_ratio=np.nan, value=0.0, sigma=np.nan,
                  pass_id=pass_id, flags=0, source="simulated", record=np.arange(n))
 
@@ -70,7 +75,7 @@ def simulate_tracking(trajectory, plan: TrackingPlan, setup, rng: np.random.Gene
         # Doppler interval [e - step, e] needs both ends above the mask in the same pass
         ok = (ids[1:] >= 0) & (ids[1:] == ids[:-1])
         e = epochs[1:][ok]
-        parts.append(_rows(e.size, plan, e, "doppler_2way", st, "Hz", plan.doppler_step, "interval_end", ids[1:][ok]))
+        parts.append(_rows(e.size, plan, e, plan.doppler, st, "Hz", plan.doppler_step, "interval_end", ids[1:][ok]))
         secs = (epochs - epochs[0]).astype("timedelta64[ns]").astype(np.int64) * 1e-9
         rsel = (ids >= 0) & (np.mod(secs, plan.range_step) == 0)
         parts.append(_rows(int(rsel.sum()), plan, epochs[rsel], "range", st, "m", 0.0, "receive", ids[rsel]))
