@@ -134,25 +134,37 @@ def _acceleration(r_bf, gm, radius, C, S, nmax, f, acc):
     ay = 0.0
     az = 0.0
     for m in range(nmax + 1):
-        for n in range(max(m, 2), nmax + 1):
-            c = C[m, n]
-            s = S[m, n]
-            p = f[3, m, n]
-            q = f[4, m, n]
-            az -= f[5, m, n] * (c * Vm[n + 1] + s * Wm[n + 1])
-            if m == 0:
-                ax -= c * p * Vn[n + 1]
-                ay -= c * p * Wn[n + 1]
-            else:
-                ax += c * (q * Vp[n + 1] - p * Vn[n + 1]) + s * (q * Wp[n + 1] - p * Wn[n + 1])
-                ay -= c * (p * Wn[n + 1] + q * Wp[n + 1]) - s * (p * Vn[n + 1] + q * Vp[n + 1])
+        # one pass over n: accumulate order m (columns m-1, m, m+1 at degree n+1) and build
+        # column m+2 in place of column m-1 (independent work the CPU overlaps with the recursion)
+        m2 = m + 2
+        f2 = f[2, m2, m2] if m2 <= ntop else 0.0
+        for n in range(m, ntop + 1):
+            if n >= 2 and n <= nmax:
+                c = C[m, n]
+                s = S[m, n]
+                p = f[3, m, n]
+                q = f[4, m, n]
+                az -= f[5, m, n] * (c * Vm[n + 1] + s * Wm[n + 1])
+                if m == 0:
+                    ax -= c * p * Vn[n + 1]
+                    ay -= c * p * Wn[n + 1]
+                else:
+                    ax += c * (q * Vp[n + 1] - p * Vn[n + 1]) + s * (q * Wp[n + 1] - p * Wn[n + 1])
+                    ay -= c * (p * Wn[n + 1] + q * Wp[n + 1]) - s * (p * Vn[n + 1] + q * Vp[n + 1])
+            if n == m2:
+                Vp[n] = f2 * (xr * Vn[m + 1] - yr * Wn[m + 1])
+                Wp[n] = f2 * (xr * Wn[m + 1] + yr * Vn[m + 1])
+            elif n > m2:
+                Vp[n] = f[0, m2, n] * zr * Vp[n - 1]
+                Wp[n] = f[0, m2, n] * zr * Wp[n - 1]
+                if n >= m2 + 2:
+                    Vp[n] -= f[1, m2, n] * rr * Vp[n - 2]
+                    Wp[n] -= f[1, m2, n] * rr * Wp[n - 2]
         if m == 0:  # central term C00 V00: d/dx V00 = -p00 V11 etc.
             ax -= C[0, 0] * f[3, 0, 0] * Vn[1]
             ay -= C[0, 0] * f[3, 0, 0] * Wn[1]
             az -= C[0, 0] * f[5, 0, 0] * Vm[1]
         Vp, Wp, Vm, Wm, Vn, Wn = Vm, Wm, Vn, Wn, Vp, Wp
-        if m + 2 <= ntop:
-            _column(m + 2, ntop, f, xr, yr, zr, rr, Vm[m + 1], Wm[m + 1], Vn, Wn)
     k = gm / (radius * radius)
     acc[0] = k * ax
     acc[1] = k * ay
