@@ -53,6 +53,8 @@ class ArcSetup:
     data_sigma: observable -> sigma along the line of sight (m or m/s).
     range_bias_sigma: per pass and receiving station (m; None: no biases; pass_id -1 = one per station).
     oscillator_sigma: (Hz, Hz/s) of the one-way oscillator bias and drift, when doppler_1way is fitted.
+    station_sigma: considered (not estimated) error of each station's ITRS coordinates (m per axis).
+    media_sigma: considered error of the media calibration scale (fraction of ``media_m``).
     edit_k: innovation k-sigma per iteration (last repeats); reweight: ARTEMIS data reweighting.
     block: filter grid spacing (s); lookback: s of trajectory kept before each segment start.
     """
@@ -71,6 +73,8 @@ class ArcSetup:
     data_sigma: dict = field(default_factory=lambda: {"range": 2.0, "doppler_2way": 1e-4})
     range_bias_sigma: float | None = 5.0
     oscillator_sigma: tuple | None = None
+    station_sigma: float | None = None
+    media_sigma: float | None = None
     edit_k: tuple = (np.inf, 10.0, 5.0)
     max_iter: int = 10
     reweight: bool = False
@@ -121,7 +125,7 @@ def select_rows(table: pd.DataFrame, setup: ArcSetup) -> tuple[pd.DataFrame, np.
 
 
 def build_registry(setup: ArcSetup, rows: pd.DataFrame) -> ParameterRegistry:
-    """Estimated parameters of the arc (Table 4.1 structure)."""
+    """Estimated and considered parameters of the arc (Table 4.1 structure)."""
     sc = setup.spacecraft
     reg = ParameterRegistry()
     reg.add_state(sc, setup.state0, setup.sigma_position, setup.sigma_velocity)
@@ -146,6 +150,14 @@ def build_registry(setup: ArcSetup, rows: pd.DataFrame) -> ParameterRegistry:
         _, bias, drift, _ = setup.measurements.oscillators[sc]
         reg.add(f"{sc}.osc_bias", "clock", bias, setup.oscillator_sigma[0], owner=sc, oscillator="bias")
         reg.add(f"{sc}.osc_drift", "clock", drift, setup.oscillator_sigma[1], owner=sc, oscillator="drift")
+    if setup.station_sigma is not None:
+        stations = sorted(set(rows["station_rx"]) | set(rows["station_tx"]) - {""})
+        for st in stations:
+            for axis in "xyz":
+                reg.add(f"station.{st}.{axis}", "station", 0.0, setup.station_sigma, owner=st, consider=True,
+                        axis=axis)
+    if setup.media_sigma is not None:
+        reg.add("media_scale", "media", 0.0, setup.media_sigma, consider=True)
     return reg
 
 
