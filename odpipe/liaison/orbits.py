@@ -28,11 +28,12 @@ def half_period_crossing(state, mu: float, t_max: float = 4.0):
     return tc, tr.state(tc)[0], tr.stm(tc)[0]
 
 
-def correct_halo(x0: float, z0: float, vy0: float, mu: float, hold: str = "x",
+def correct_halo(x0: float, z0: float, vy0: float, mu: float, hold: str = "z",
                  tol: float = 1e-11):
     """Periodic orbit through (x0, 0, z0) with velocity (0, vy0, 0): (state, period).
 
-    ``hold``: 'x' keeps x0 and corrects (z0, vy0); 'z' keeps z0 and corrects (x0, vy0).
+    ``hold``: 'z' keeps z0 and corrects (x0, vy0) (the amplitude stays: a halo, not the
+    planar Lyapunov orbit that holding x0 near the bifurcation can fall onto); 'x' keeps x0.
     """
     s = np.array([x0, 0.0, z0, 0.0, vy0, 0.0])
     free = [2, 4] if hold == "x" else [0, 4]
