@@ -18,6 +18,9 @@ station         ITRS offset (m) of station ``owner`` from the catalog, ``info['a
 media           offset of the media scale from ``setup.media_scale`` (linear, exact)
 ==============  =================================================================================
 
+Other kinds (``maneuver_epoch``, ``eop``) are refused. Linear kinds enter as
+``computed + H x`` (exact for biases and the media scale; station offsets to first order).
+
 Efficiency and exactness. The arc is cut into segments at the epochs where the
 reference may change (stochastic-batch boundaries, maneuvers); each segment is
 integrated once per relinearization (:class:`.segment.SegmentTrajectory`) and

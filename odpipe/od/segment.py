@@ -17,7 +17,9 @@ the measurement models read, with
 
 The look-back flies the segment's own parameters: a stochastic acceleration of
 the previous batch acts there as the current one (an error of order
-``da * lookback**2 / 2``, micrometres for 1e-9 m/s^2 over 70 s); everything else is exact.
+``da * lookback**2 / 2``, micrometres for 1e-9 m/s^2 over 70 s), and a maneuver of the
+previous segment less than ``lookback`` before ``a`` is not undone there (keep maneuvers and
+batch boundaries further apart than the look-back); everything else is exact.
 """
 
 from __future__ import annotations
