@@ -132,3 +132,43 @@ def test_same_seed_same_bytes(sim, tmp_path):
     again, _, _ = run_case(CASE, tmp_path, days=DAYS)
     for role in ("trk234", "utdf:BGS", "tro", "maneuvers", "spk"):
         assert hashlib.sha256(paths[role].read_bytes()).digest() == hashlib.sha256(again[role].read_bytes()).digest(), role
+
+
+def test_usn_range_reads_back(sim):
+    paths, _, obs = sim
+    d = utdf.read(paths["utdf:USHS"])
+    got = d.table[d.table["observable"] == "range"].reset_index(drop=True)
+    want = obs.table[(obs.table["station_rx"] == "USHS") & (obs.table["observable"] == "range")].reset_index(drop=True)
+    assert len(got) == len(want) > 0
+    # 1/256 ns of round-trip delay: half a unit of rounding
+    assert np.abs(got["value"].to_numpy() - want["value"].to_numpy()).max() <= 0.5 / 256e9 + 1e-18
+
+
+def test_truth_spk_and_oem_read_back(sim):
+    import spiceypy as sp
+
+    from parsers import oem
+
+    paths, truth, _ = sim
+    t = np.linspace(truth.trajectory.t0 + 10.0, truth.trajectory.t1 - 10.0, 37)
+    sp.furnsh(str(paths["spk"]))
+    try:
+        got = np.array([sp.spkgeo(-902, float(x), "J2000", 399)[0] for x in t]) * 1e3
+    finally:
+        sp.unload(str(paths["spk"]))
+    want = truth.trajectory.state(t)
+    assert np.abs(got[:, :3] - want[:, :3]).max() < 1e-3       # m: Hermite on 600-s steps
+    segs = oem.read(paths["oem"])
+    assert len(segs) == len(truth.epochs) + 1
+
+
+def test_executed_maneuvers_differ_from_design_by_the_error_model():
+    from odpipe.simulate.truth import executed_dv
+
+    rng = np.random.default_rng(1)
+    d = np.tile([0.3, -0.2, 0.1], (4000, 1))
+    e = executed_dv(d, 0.02, np.radians(2.0), rng)
+    mag = np.linalg.norm(e, axis=1) / np.linalg.norm(d[0]) - 1
+    ang = np.arccos(np.clip(e @ d[0] / np.linalg.norm(e, axis=1) / np.linalg.norm(d[0]), -1, 1))
+    assert abs(mag.std() - 0.02) < 0.002
+    assert abs(np.sqrt(np.mean(ang**2)) - np.radians(2.0)) < np.radians(0.1)

@@ -164,7 +164,7 @@ def _segments(traj, breaks, step_s) -> list:
     edges = np.concatenate([[traj.t0], np.sort(breaks), [traj.t1]])
     segs = []
     for a, b in zip(edges[:-1], edges[1:]):
-        ts = np.unique(np.concatenate([np.arange(a, b, step_s), [b]]))
+        ts = np.linspace(a, b, int(np.ceil((b - a) / step_s - 1e-6)) + 1)   # even steps <= step_s, ends exact
         states = traj.state(ts)
         if b in breaks:  # end of a segment: the pre-maneuver state (the trajectory gives the post-maneuver one)
             states[-1] = traj.state(np.nextafter(b, a))[0]
