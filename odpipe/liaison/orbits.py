@@ -74,13 +74,14 @@ def halo_by_period(period: float, x0: float, vy0: float, z_start: float, z_stop:
     k = np.flatnonzero(np.sign(miss[:-1]) != np.sign(miss[1:]))
     if k.size == 0:
         raise ValueError(f"no halo of period {period} for z0 in [{z_start}, {z_stop}]")
-    left = fam[k[0]][0]
+    za, zb = z0s[k[0]], z0s[k[0] + 1]
+    a, b = fam[k[0]][0][[0, 4]], fam[k[0] + 1][0][[0, 4]]
 
-    def f(z):
-        return correct_halo(left[0], z, left[4], mu, hold="z")[1] - period
+    def member(z):             # guess interpolated between the bracketing members
+        g = a + (b - a) * (z - za) / (zb - za)
+        return correct_halo(g[0], z, g[1], mu, hold="z")
 
-    z0 = brentq(f, z0s[k[0]], z0s[k[0] + 1], xtol=1e-13)
-    return correct_halo(left[0], z0, left[4], mu, hold="z")
+    return member(brentq(lambda z: member(z)[1] - period, za, zb, xtol=1e-13))
 
 
 def keplerian_orbit(period: float, ecc: float, inc: float, mu: float, raan: float = 0.0,

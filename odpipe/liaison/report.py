@@ -17,7 +17,7 @@ def _cell(v) -> str:
     if isinstance(v, (float, np.floating)):
         if not np.isfinite(v):
             return "-"
-        return f"{v:.3g}" if abs(v) >= 1e-3 or v == 0 else f"{v:.2e}"
+        return f"{v:.4g}" if abs(v) >= 1e-3 or v == 0 else f"{v:.3e}"
     return str(v)
 
 
