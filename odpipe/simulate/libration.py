@@ -72,23 +72,26 @@ def _crtbp_accel(s, mu):
 
 
 def rotating_to_icrf(state_nd, mu: float, moon_state) -> np.ndarray:
-    """Geocentric ICRF state (m, m/s) of a nondimensional barycentric rotating state, given the Moon's geocentric state."""
+    """Geocentric ICRF state (m, m/s) of a nondimensional barycentric rotating state, given the Moon's geocentric state.
+
+    Pulsating frame: r = mu r_moon + d M^T rho, v = mu v_moon + M^T rho' d |w| + w x rel + (d'/d) rel.
+    """
     r_m, v_m = np.asarray(moon_state[:3], float), np.asarray(moon_state[3:6], float)
     m, omega = synodic_matrix(r_m, v_m)
     d = np.linalg.norm(r_m)
     w = np.linalg.norm(omega)
     rel = m.T @ (np.asarray(state_nd[:3]) * d)
     rel_v = m.T @ (np.asarray(state_nd[3:6]) * d * w)
-    r = rel + mu * r_m
-    v = rel_v + np.cross(omega, rel) + mu * v_m
-    return np.concatenate([r, v])
+    return np.concatenate([rel + mu * r_m, rel_v + np.cross(omega, rel) + (r_m @ v_m / d**2) * rel + mu * v_m])
 
 
 def icrf_to_rotating(state, mu: float, moon_state) -> np.ndarray:
-    """Nondimensional barycentric rotating state(s) (N,6) of geocentric ICRF state(s) (N,6) given the Moon's (N,6)."""
-    from odpipe.frames.local import earth_moon_rotating_state
-
-    s, m = np.atleast_2d(state), np.atleast_2d(moon_state)
-    r, v = earth_moon_rotating_state(s[:, :3], s[:, 3:], m[:, :3], m[:, 3:], mass_ratio=mu, normalize=True)
-    return np.concatenate([r, v], axis=1)
-
+    """Nondimensional pulsating rotating states (N,6) of geocentric ICRF states (N,6); inverse of :func:`rotating_to_icrf`."""
+    s, mo = np.atleast_2d(state), np.atleast_2d(moon_state)
+    r_m, v_m = mo[:, :3], mo[:, 3:]
+    m, omega = synodic_matrix(r_m, v_m)
+    d = np.linalg.norm(r_m, axis=1, keepdims=True)
+    w = np.linalg.norm(omega, axis=1, keepdims=True)
+    rel = s[:, :3] - mu * r_m
+    rel_v = s[:, 3:] - mu * v_m - np.cross(omega, rel) - np.sum(r_m * v_m, 1, keepdims=True) / d**2 * rel
+    return np.concatenate([np.einsum("nij,nj->ni", m, rel) / d, np.einsum("nij,nj->ni", m, rel_v) / (d * w)], axis=1)
