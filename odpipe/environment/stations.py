@@ -175,8 +175,8 @@ def _read_stations(path: Path) -> list[Station]:
     v = np.stack([pd.to_numeric(_column(df, f"v{c}_m_per_yr", f"v{c}", default=0.0), errors="coerce")
                   .fillna(0.0).to_numpy(float) for c in "xyz"], -1)
     epoch = pd.to_numeric(_column(df, "epoch_year", default=2003.0), errors="coerce").fillna(2003.0).to_numpy(float)
-    cplx = _column(df, "complex", default="").fillna("").astype(str)
-    aliases = _column(df, "aliases", default="").fillna("").astype(str)
+    cplx = _column(df, "complex", default="").astype(object).fillna("").astype(str)
+    aliases = _column(df, "aliases", default="").astype(object).fillna("").astype(str)
     if np.any(~np.isfinite(r)):
         bad = names[~np.isfinite(r).all(axis=1)].iloc[0]
         raise ValueError(f"{path}: station {bad!r} has non-numeric coordinates")

@@ -46,7 +46,7 @@ def run_batch(configs, run_one: Callable[[Path], dict], *, scheduler: str | None
 
     configs = [str(c) for c in configs]
     cluster = None if scheduler else LocalCluster(n_workers=workers, threads_per_worker=1,
-                                                  processes=True, dashboard_address=None)
+                                                  processes=True, dashboard_address=":0")  # any free port: never clash with a running cluster
     outcomes: list[ArcOutcome] = []
     with Client(scheduler or cluster) as client:
         futures = [client.submit(_guarded, run_one, c, key=f"arc-{i}", pure=False) for i, c in enumerate(configs)]
