@@ -15,7 +15,7 @@ and computable by the models (otherwise reported with the reason).
 
 from __future__ import annotations
 
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 
 import numpy as np
 import pandas as pd
@@ -30,6 +30,7 @@ from odpipe.preprocess.timetags import interval_bounds
 from odpipe.time import utc_to_tdb
 
 from .problem import TrackingProblem
+from .rotation import TabulatedRotation
 
 
 @dataclass(frozen=True)
@@ -57,6 +58,8 @@ class ArcSetup:
     media_sigma: considered error of the media calibration scale (fraction of ``media_m``).
     edit_k: innovation k-sigma per iteration (last repeats); reweight: ARTEMIS data reweighting.
     block: filter grid spacing (s); lookback: s of trajectory kept before each segment start.
+    tabulate_earth_rotation: evaluate the GCRS->ITRS matrix from a per-arc Chebyshev table
+    (:mod:`.rotation`, < 1e-12 rad) instead of the full model at every event.
     """
 
     spacecraft: str
@@ -80,6 +83,7 @@ class ArcSetup:
     reweight: bool = False
     block: float = 600.0
     lookback: float = 120.0
+    tabulate_earth_rotation: bool = True
 
 
 @dataclass
@@ -175,8 +179,13 @@ def fit_arc(table: pd.DataFrame, setup: ArcSetup) -> ArcSolution:
                          reweight=setup.reweight)
     grid, _ = build_grid(reg, setup.start, setup.end, options.block, options.extra_epochs)
 
+    meas = setup.measurements
+    if setup.tabulate_earth_rotation and meas.gcrs_to_itrs is not None:
+        span = (setup.start - setup.lookback - 3600.0, setup.end + 3600.0)
+        meas = replace(meas, gcrs_to_itrs=TabulatedRotation(meas.gcrs_to_itrs, *span))
+
     def problem_for(r, t):
-        return TrackingProblem(reg, r, t, {setup.spacecraft: setup.force_model}, setup.measurements,
+        return TrackingProblem(reg, r, t, {setup.spacecraft: setup.force_model}, meas,
                                setup.start, setup.end, setup.lookback, epochs=grid)
 
     problem = problem_for(rows, times)
