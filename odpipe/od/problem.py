@@ -260,8 +260,8 @@ class TrackingProblem:
         H = seg.H_lin[loc]
         computed = seg.value[loc] + H[:, self._lin_idx] @ x0[self._lin_idx]
         for sc, traj in seg.trajs.items():
-            _, Phi0, S0 = traj.at(t0)
-            Hx = np.linalg.solve(Phi0.T, seg.G_x[sc][loc].T).T
+            _, _, Phi0_inv, S0 = traj.at(t0)
+            Hx = seg.G_x[sc][loc] @ Phi0_inv
             H[:, self._sc[sc]["state"]] = Hx
             H[:, seg.pidx[sc]] += seg.G_p[sc][loc] - Hx @ S0
         return computed, H
@@ -275,9 +275,9 @@ class TrackingProblem:
         x1, Phi = x0.copy(), np.eye(x0.size)
         for sc, traj in seg.trajs.items():
             st = self._sc[sc]["state"]
-            _, Phi0, S0 = traj.at(t0)
-            x_1, Phi1, S1 = traj.at(t1)
-            M = np.linalg.solve(Phi0.T, Phi1.T).T
+            _, _, Phi0_inv, S0 = traj.at(t0)
+            x_1, Phi1, _, S1 = traj.at(t1)
+            M = Phi1 @ Phi0_inv
             x1[st] = x_1
             Phi[np.ix_(st, st)] = M
             Phi[np.ix_(st, seg.pidx[sc])] = S1 - M @ S0

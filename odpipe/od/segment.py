@@ -50,7 +50,7 @@ class SegmentTrajectory:
         self._back = propagate(self.x_start, a, a - lookback, force_model, with_stm=True,
                                params=list(params), rtol=rtol, atol=atol)
         self.n_eval = self._fwd.n_eval + self._back.n_eval
-        self._memo: dict = {float(a): (self.x_start, np.eye(6), np.zeros((6, len(self.param_names))))}
+        self._memo: dict = {float(a): (self.x_start, np.eye(6), np.eye(6), np.zeros((6, len(self.param_names))))}
 
     def _pieces(self, t):
         t = np.atleast_1d(np.asarray(t, float))
@@ -92,8 +92,8 @@ class SegmentTrajectory:
 
         return self._apply(t, back, fwd, (6, p))
 
-    def at(self, t: float) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-        """(x, Phi, S) at one epoch, the state at ``a`` taken before its maneuver (Phi = I, S = 0).
+    def at(self, t: float) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+        """(x, Phi, Phi^-1, S) at one epoch, the state at ``a`` taken before its maneuver (Phi = I, S = 0).
 
         Served from :meth:`preload` or remembered: the filter asks for each grid epoch twice."""
         t = float(t)
@@ -102,8 +102,9 @@ class SegmentTrajectory:
         return self._memo[t]
 
     def preload(self, epochs) -> None:
-        """Evaluate (x, Phi, S) at ``epochs`` inside the segment in one vectorized pass."""
+        """Evaluate (x, Phi, Phi^-1, S) at ``epochs`` inside the segment in one vectorized pass."""
         ts = np.asarray([t for t in np.atleast_1d(epochs) if self.t0 < t <= self.t1 and t not in self._memo], float)
         if ts.size:
             x, Phi, S = self.state(ts), self.stm(ts), self.sensitivity(ts)
-            self._memo.update({float(t): (x[i], Phi[i], S[i]) for i, t in enumerate(ts)})
+            inv = np.linalg.inv(Phi)
+            self._memo.update({float(t): (x[i], Phi[i], inv[i], S[i]) for i, t in enumerate(ts)})
