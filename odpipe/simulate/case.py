@@ -7,7 +7,9 @@ Schema (SI units unless the key says otherwise; times UTC ISO 8601)::
     [spacecraft]   mass_kg, radius_m, length_m, rho_s, rho_d, spin_axis ([x,y,z] ICRF),
                    spin_rpm, antenna_offset_m (0: no spin signature in the Doppler)
     [stochastic]   sigma (m/s^2 per RTN axis), tau_s (Gauss-Markov time; 0 = white), batch_s
-    [[maneuver]]   name, epoch, kind ('station-keeping' | 'attitude'), dv ([x,y,z] ICRF m/s, designed)
+    [station_keeping] first_days, every_days (epochs after the start), gap_days, horizon_days
+                   (designed at run time: perpendicular x-z crossing after gap, see odpipe.simulate.stationkeeping)
+    [[maneuver]]   name, epoch, kind (e.g. 'attitude'), dv ([x,y,z] ICRF m/s, designed)
     [execution]    sigma_magnitude (fraction), sigma_pointing_deg (per maneuver)
     [media]        sigma_wet_m, sigma_dry_m (per-day deviations from the DSN seasonal model)
     [[network]]    station, format ('trk234'|'utdf'), pad (UTDF pad id), band, uplink_hz,
@@ -59,11 +61,18 @@ class Case:
     maneuvers: list
     execution: dict
     media: dict
+    station_keeping: dict
     networks: tuple = field(default_factory=tuple)
 
     @property
     def end(self) -> np.datetime64:
         return self.start + np.timedelta64(int(self.days * 86400e9), "ns")
+
+    def station_keeping_epochs(self) -> np.ndarray:
+        """UTC epochs of the station-keeping maneuvers inside the case span."""
+        sk = self.station_keeping
+        days = np.arange(float(sk["first_days"]), self.days, float(sk["every_days"]))
+        return self.start + (days * 86400e9).astype("timedelta64[ns]")
 
     def shortened(self, days: float) -> "Case":
         """The same case over its first ``days`` (maneuvers after the end dropped)."""
@@ -82,4 +91,4 @@ def load(path) -> Case:
     return Case(d["name"], int(d["seed"]), utc(d["start"]), float(d["days"]), int(d["spacecraft"]),
                 int(d["naif_id"]), d["orbit"], d["spacecraft_model"], d["stochastic"],
                 sorted(mans, key=lambda m: m["epoch"]), d["execution"], d["media"],
-                tuple(Network(**n) for n in d["network"]))
+                d["station_keeping"], tuple(Network(**n) for n in d["network"]))

@@ -105,12 +105,15 @@ def utdf_records(table: pd.DataFrame, pad: int, sc: int) -> pd.DataFrame:
     }, index=pd.RangeIndex(n, name="record"))[utdf.RECORD_FIELDS]
 
 
-def maneuver_plan(case) -> pd.DataFrame:
-    """The designed maneuvers in the parsers.maneuvers plan schema (ICRF, impulsive)."""
+def maneuver_plan(maneuvers, dv=None) -> pd.DataFrame:
+    """Maneuvers (designed, or ``dv`` (K,3) instead) in the parsers.maneuvers plan schema (ICRF, impulsive)."""
     rows = [{"name": m["name"], "epoch": m["epoch"], "kind": "impulsive", "frame": "ICRF",
              "dv1": m["dv"][0], "dv2": m["dv"][1], "dv3": m["dv"][2],
-             "sigma_dv": 0.01 if m["kind"] == "station-keeping" else 0.001, "sigma_time": 10.0} for m in case.maneuvers]
-    return pd.DataFrame(rows, columns=PLAN_COLUMNS).astype({c: float for c in PLAN_COLUMNS[4:]})
+             "sigma_dv": 0.01 if m["kind"] == "station-keeping" else 0.001, "sigma_time": 10.0} for m in maneuvers]
+    plan = pd.DataFrame(rows, columns=PLAN_COLUMNS).astype({c: float for c in PLAN_COLUMNS[4:]})
+    if dv is not None:
+        plan[["dv1", "dv2", "dv3"]] = dv
+    return plan
 
 
 def write_case(out: Path, case, truth, obs, tro_text: str, setup, stations_csv: Path, step_s: float = 600.0) -> dict:
@@ -144,11 +147,9 @@ def write_case(out: Path, case, truth, obs, tro_text: str, setup, stations_csv: 
     paths["tro"] = out / f"{case.name}.TRO"
     paths["tro"].write_text(tro_text)
     paths["maneuvers"] = out / "maneuvers_designed.csv"
-    write_plan(maneuver_plan(case), paths["maneuvers"])
-    executed = maneuver_plan(case)
-    executed[["dv1", "dv2", "dv3"]] = truth.executed
+    write_plan(maneuver_plan(truth.maneuvers), paths["maneuvers"])
     paths["maneuvers_executed"] = out / "maneuvers_executed_truth.csv"
-    write_plan(executed, paths["maneuvers_executed"])
+    write_plan(maneuver_plan(truth.maneuvers, truth.executed), paths["maneuvers_executed"])
     paths["stations"] = out / "stations.csv"
     shutil.copyfile(stations_csv, paths["stations"])
     seg = _segments(truth.trajectory, truth.epochs, step_s)

@@ -3,7 +3,11 @@
 * stochastic accelerations: piecewise-constant RTN batches from a first-order
   Gauss-Markov sequence a[k+1] = m a[k] + sqrt(1 - m^2) sigma w[k],
   m = exp(-batch/tau) (white when tau = 0), seeded;
-* maneuvers: the designed ICRF delta-v scaled by (1 + e_mag) and turned by a
+* initial state: the CRTBP Lyapunov state in the DE421 geometry, its velocity corrected
+  for a perpendicular x-z plane crossing (:mod:`odpipe.simulate.stationkeeping`);
+* maneuvers: station-keeping delta-v designed in time order on the true state at the
+  maneuver epoch (as operations would from OD), attitude maneuvers as given; each
+  executed as the designed ICRF delta-v scaled by (1 + e_mag) and turned by a
   pointing error (angle ~ N(0, sigma) about a random axis normal to it);
 * force model: Earth centre, Moon and Sun point masses (DE421), SRP on a spinning
   cylinder (axis fixed in ICRF) with Earth and Moon shadow, the batches, the maneuvers.
@@ -11,7 +15,7 @@
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 import numpy as np
 
@@ -19,6 +23,7 @@ from odpipe.dynamics import (Cylinder, EmpiricalRTN, ForceModel, ImpulsiveManeuv
                              SolarRadiationPressure, propagate)
 from odpipe.dynamics.trajectory import Trajectory
 from odpipe.simulate.libration import lyapunov_orbit, rotating_to_icrf
+from odpipe.simulate.stationkeeping import design_dv
 from odpipe.time import utc_to_tdb
 
 MARGIN_S = 3600.0  # trajectory starts this long before the first sample (light time, uplink legs)
@@ -28,6 +33,7 @@ MARGIN_S = 3600.0  # trajectory starts this long before the first sample (light 
 class Truth:
     trajectory: Trajectory
     force_model: ForceModel
+    maneuvers: list          # dicts: name, epoch (UTC), kind, dv (designed, ICRF m/s)
     designed: np.ndarray     # (K,3) ICRF m/s
     executed: np.ndarray     # (K,3) ICRF m/s
     epochs: np.ndarray       # (K,) TDB s
@@ -69,21 +75,31 @@ def simulate_truth(case, ephemeris, rng) -> Truth:
     """Propagate the case's truth from MARGIN_S before its start to its end (+ margin)."""
     t0 = float(utc_to_tdb(case.start)) - MARGIN_S
     t1 = float(utc_to_tdb(case.end)) + MARGIN_S
-    sc = case.body
-    st = case.stochastic
+    sc, st, ex, sk = case.body, case.stochastic, case.execution, case.station_keeping
     batches = gauss_markov_batches(t0, t1, float(st["batch_s"]), float(st["sigma"]), float(st["tau_s"]), rng)
-    designed = np.array([m["dv"] for m in case.maneuvers]).reshape(-1, 3)
-    epochs = np.array([float(utc_to_tdb(m["epoch"])) for m in case.maneuvers])
-    ex = case.execution
-    executed = executed_dv(designed, float(ex["sigma_magnitude"]), np.radians(float(ex["sigma_pointing_deg"])), rng) \
-        if len(designed) else designed
     axis = np.asarray(sc["spin_axis"], float)
-    fm = ForceModel("earth", [
+    nominal = ForceModel("earth", [
         PointMasses(["moon", "sun"]),
         SolarRadiationPressure(surfaces=[Cylinder(axis / np.linalg.norm(axis), float(sc["radius_m"]),
                                                   float(sc["length_m"]), float(sc["rho_s"]), float(sc["rho_d"]))]),
-        EmpiricalRTN(batches),
-        *[ImpulsiveManeuver(t, dv) for t, dv in zip(epochs, executed)],
     ], mass=float(sc["mass_kg"]), ephemeris=ephemeris)
-    traj = propagate(initial_state(case, ephemeris, t0), t0, t1, fm, with_stm=False)
-    return Truth(traj, fm, designed, executed, epochs, batches)
+    gap, horizon = float(sk["gap_days"]) * 86400.0, float(sk["horizon_days"]) * 86400.0
+    x0 = initial_state(case, ephemeris, t0)
+    x0[3:] += design_dv(nominal, x0, t0, gap, horizon)
+    events = sorted([dict(m) for m in case.maneuvers]
+                    + [{"name": f"SK-{k + 1}", "epoch": e, "kind": "station-keeping", "dv": None}
+                       for k, e in enumerate(case.station_keeping_epochs())], key=lambda m: m["epoch"])
+    components = nominal.components + [EmpiricalRTN(batches)]
+    executed = []
+    for m in events:
+        t = float(utc_to_tdb(m["epoch"]))
+        fm = replace(nominal, components=components + [ImpulsiveManeuver(e, dv) for e, dv in executed])
+        if m["dv"] is None:
+            state = propagate(x0, t0, t, fm, with_stm=False).state(t)[0]
+            m["dv"] = design_dv(nominal, state, t, gap, horizon)
+        executed.append((t, executed_dv(m["dv"], float(ex["sigma_magnitude"]),
+                                        np.radians(float(ex["sigma_pointing_deg"])), rng)[0]))
+    fm = replace(nominal, components=components + [ImpulsiveManeuver(e, dv) for e, dv in executed])
+    traj = propagate(x0, t0, t1, fm, with_stm=False)
+    return Truth(traj, fm, events, np.array([m["dv"] for m in events]).reshape(-1, 3),
+                 np.array([dv for _, dv in executed]).reshape(-1, 3), np.array([e for e, _ in executed]), batches)

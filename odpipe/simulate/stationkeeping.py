@@ -1,0 +1,62 @@
+"""Station-keeping of an Earth-Moon libration orbit: perpendicular x-z plane crossings.
+
+A maneuver at t is the delta-v of least norm that makes the rotating-frame x
+velocity vanish at the first crossing of the x-z plane (y = 0, pulsating
+Earth-Moon frame) later than t + ``gap`` — the classic crossing control that
+removes the unstable component. Solved by Newton steps along the
+finite-difference gradient (steps clipped to ``max_step`` m/s), with the
+design force model (no stochastic accelerations, no execution errors).
+"""
+
+from __future__ import annotations
+
+from dataclasses import replace
+
+import numpy as np
+from scipy.optimize import brentq
+
+from odpipe.dynamics import propagate
+from odpipe.simulate.libration import icrf_to_rotating
+
+GRID_S = 1800.0
+
+
+def crossing_vx(force_model, state, t: float, gap: float, horizon: float) -> float:
+    """Rotating x velocity (nondimensional) at the first y = 0 crossing in [t + gap, t + horizon] (NaN if none)."""
+    eph = force_model.ephemeris
+    mu = eph.gm("moon") / (eph.gm("moon") + eph.gm("earth"))
+    tr = propagate(state, t, t + horizon, force_model, with_stm=False)
+
+    def rot(ts):
+        return icrf_to_rotating(tr.state(ts), mu, eph.state("moon", "earth", ts))
+
+    ts = t + np.arange(gap, horizon, GRID_S)
+    y = rot(ts)[:, 1]
+    k = np.flatnonzero(np.sign(y[1:]) != np.sign(y[:-1]))
+    if not k.size:
+        return np.nan
+    tc = brentq(lambda q: rot(np.array([q]))[0, 1], ts[k[0]], ts[k[0] + 1], xtol=1e-3)
+    return float(rot(np.array([tc]))[0, 3])
+
+
+def design_dv(force_model, state, t: float, gap: float = 3 * 86400.0, horizon: float = 11 * 86400.0,
+              max_step: float = 0.5, iterations: int = 8) -> np.ndarray:
+    """ICRF delta-v (3,) m/s at TDB ``t`` for a perpendicular crossing after ``t + gap``."""
+    fm = replace(force_model, components=[c for c in force_model.components if not hasattr(c, "dv")])
+
+    def f(dv):
+        x = np.array(state, float)
+        x[3:] += dv
+        return crossing_vx(fm, x, t, gap, horizon)
+
+    dv = np.zeros(3)
+    for _ in range(iterations):
+        r = f(dv)
+        if not np.isfinite(r):
+            raise ValueError(f"no x-z plane crossing within {horizon / 86400:.1f} days of t={t:.0f}")
+        g = np.array([(f(dv + 1e-3 * e) - r) / 1e-3 for e in np.eye(3)])
+        step = -r * g / (g @ g)
+        dv = dv + step * min(1.0, max_step / np.linalg.norm(step))
+        if np.linalg.norm(step) < 1e-7:
+            break
+    return dv
