@@ -13,7 +13,7 @@ from odpipe.products.atomic import write_text
 NAME = "liaison"
 HELP = "LiAISON crosslink navigation scenario (runs/liaison_*.toml): tables beside the paper's, plots"
 
-SCENARIOS = ("turan", "baseline")  # modules of odpipe.liaison
+SCENARIOS = ("turan", "baseline", "doppler")  # modules of odpipe.liaison
 
 
 def add_arguments(p):
@@ -29,9 +29,9 @@ def run(args) -> int:
     if name not in SCENARIOS:
         raise SystemExit(f"{args.config}: scenario must be one of {SCENARIOS}, got {name!r}")
     if args.runs is not None:
-        cfg["montecarlo"]["runs"] = args.runs
+        cfg.setdefault("montecarlo", {})["runs"] = args.runs
     if args.parallel:
-        cfg["montecarlo"]["parallel"] = True
+        cfg.setdefault("montecarlo", {})["parallel"] = True
     out = args.out or Path("runs/out") / args.config.stem
     out.mkdir(parents=True, exist_ok=True)
     t0 = time.time()
