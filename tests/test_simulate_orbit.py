@@ -59,3 +59,28 @@ def test_spin_signature_is_the_count_average_of_the_rate():
     for k in range(2):
         rate = a * w * np.cos(w * (t[k] - ct + ct * tau) + phi)
         assert abs(np.trapezoid(rate, tau) - got[k]) < 1e-10
+
+
+def test_embedded_case_stays_at_l1_four_weeks_with_small_station_keeping():
+    from pathlib import Path
+
+    from odpipe.environment.ephemeris import Ephemeris
+    from odpipe.simulate.case import load
+    from odpipe.simulate.truth import simulate_truth
+
+    case = load(Path(__file__).resolve().parents[1] / "runs" / "artemis_p2_like.toml")
+    eph = Ephemeris.open("de421")
+    truth = simulate_truth(case, eph, np.random.default_rng(case.seed))
+    mu = eph.gm("moon") / (eph.gm("moon") + eph.gm("earth"))
+    t = np.linspace(truth.trajectory.t0, truth.trajectory.t1, 600)
+    assert t[-1] - t[0] >= 28 * 86400.0
+    rot = icrf_to_rotating(truth.trajectory.state(t), mu, eph.state("moon", "earth", t))
+    # the Lyapunov orbit's size (0.01 in x, 0.04 in y; 1 = 384400 km) kept to within 25 %
+    assert np.abs(rot[:, 0] - collinear_point(MU, 1)).max() < 0.0125
+    assert np.abs(rot[:, 1]).max() < 0.05
+    sk = np.array([m["kind"] == "station-keeping" for m in truth.maneuvers])
+    assert sk.sum() == 4 and np.allclose(np.diff(truth.epochs[sk]), 7 * 86400.0, atol=0.01)   # TDB - UTC wobble
+    dv = np.linalg.norm(truth.designed[sk], axis=1)
+    assert dv.max() < 1.0 and dv.min() > 0.0
+    err = np.linalg.norm(truth.executed - truth.designed, axis=1) / np.linalg.norm(truth.designed, axis=1)
+    assert 0 < err.max() < 0.05          # execution errors applied (0.5 %, 0.5 deg 1-sigma)

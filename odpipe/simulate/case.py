@@ -7,7 +7,7 @@ Schema (SI units unless the key says otherwise; times UTC ISO 8601)::
     [spacecraft]   mass_kg, radius_m, length_m, rho_s, rho_d, spin_axis ([x,y,z] ICRF),
                    spin_rpm, antenna_offset_m (0: no spin signature in the Doppler)
     [stochastic]   sigma (m/s^2 per RTN axis), tau_s (Gauss-Markov time; 0 = white), batch_s
-    [station_keeping] first_days, every_days (epochs after the start), gap_days, horizon_days
+    [station_keeping] first_days, every_days (epochs after the start), gap_days (list), horizon_days
                    (designed at run time: perpendicular x-z crossing after gap, see odpipe.simulate.stationkeeping)
     [[maneuver]]   name, epoch, kind (e.g. 'attitude'), dv ([x,y,z] ICRF m/s, designed)
     [execution]    sigma_magnitude (fraction), sigma_pointing_deg (per maneuver)

@@ -3,7 +3,8 @@
 A maneuver at t is the delta-v of least norm that makes the rotating-frame x
 velocity vanish at the first crossing of the x-z plane (y = 0, pulsating
 Earth-Moon frame) later than t + ``gap`` — the classic crossing control that
-removes the unstable component. Solved by Newton steps along the
+removes the unstable component. Of several gaps the smallest delta-v is kept
+(a crossing soon after the maneuver gives little leverage). Solved by Newton steps along the
 finite-difference gradient (steps clipped to ``max_step`` m/s), with the
 design force model (no stochastic accelerations, no execution errors).
 """
@@ -32,6 +33,8 @@ def crossing_vx(force_model, state, t: float, gap: float, horizon: float) -> flo
 
     ts = t + np.arange(gap, horizon, GRID_S)
     y = rot(ts)[:, 1]
+    if not np.isfinite(y).all():
+        return np.nan
     k = np.flatnonzero(np.sign(y[1:]) != np.sign(y[:-1]))
     if not k.size:
         return np.nan
@@ -39,9 +42,17 @@ def crossing_vx(force_model, state, t: float, gap: float, horizon: float) -> flo
     return float(rot(np.array([tc]))[0, 3])
 
 
-def design_dv(force_model, state, t: float, gap: float = 3 * 86400.0, horizon: float = 11 * 86400.0,
-              max_step: float = 0.5, iterations: int = 8) -> np.ndarray:
-    """ICRF delta-v (3,) m/s at TDB ``t`` for a perpendicular crossing after ``t + gap``."""
+def design_dv(force_model, state, t: float, gaps=(1.5 * 86400.0, 3 * 86400.0, 4.5 * 86400.0),
+              horizon: float = 8 * 86400.0) -> np.ndarray:
+    """ICRF delta-v (3,) m/s at TDB ``t``: the smallest of the crossing designs for ``gaps`` (s; horizon past each)."""
+    found = [dv for dv in (_crossing_dv(force_model, state, t, g, g + horizon) for g in gaps) if dv is not None]
+    if not found:
+        raise ValueError(f"no station-keeping solution at t={t:.0f} for gaps {gaps}")
+    return min(found, key=np.linalg.norm)
+
+
+def _crossing_dv(force_model, state, t, gap, horizon, max_step: float = 0.5, iterations: int = 12):
+    """Delta-v for a perpendicular crossing after ``t + gap``, or None when Newton fails."""
     fm = replace(force_model, components=[c for c in force_model.components if not hasattr(c, "dv")])
 
     def f(dv):
@@ -52,11 +63,11 @@ def design_dv(force_model, state, t: float, gap: float = 3 * 86400.0, horizon: f
     dv = np.zeros(3)
     for _ in range(iterations):
         r = f(dv)
-        if not np.isfinite(r):
-            raise ValueError(f"no x-z plane crossing within {horizon / 86400:.1f} days of t={t:.0f}")
         g = np.array([(f(dv + 1e-3 * e) - r) / 1e-3 for e in np.eye(3)])
+        if not (np.isfinite(r) and np.isfinite(g).all()):
+            return None
         step = -r * g / (g @ g)
         dv = dv + step * min(1.0, max_step / np.linalg.norm(step))
-        if np.linalg.norm(step) < 1e-7:
-            break
-    return dv
+        if abs(r) < 1e-8:          # 1e-8 of ~1 km/s: 1e-5 m/s of crossing velocity
+            return dv
+    return None

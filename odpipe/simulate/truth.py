@@ -83,9 +83,10 @@ def simulate_truth(case, ephemeris, rng) -> Truth:
         SolarRadiationPressure(surfaces=[Cylinder(axis / np.linalg.norm(axis), float(sc["radius_m"]),
                                                   float(sc["length_m"]), float(sc["rho_s"]), float(sc["rho_d"]))]),
     ], mass=float(sc["mass_kg"]), ephemeris=ephemeris)
-    gap, horizon = float(sk["gap_days"]) * 86400.0, float(sk["horizon_days"]) * 86400.0
+    gaps = tuple(np.atleast_1d(np.asarray(sk["gap_days"], float)) * 86400.0)
+    horizon = float(sk["horizon_days"]) * 86400.0
     x0 = initial_state(case, ephemeris, t0)
-    x0[3:] += design_dv(nominal, x0, t0, gap, horizon)
+    x0[3:] += design_dv(nominal, x0, t0, gaps, horizon)
     events = sorted([dict(m) for m in case.maneuvers]
                     + [{"name": f"SK-{k + 1}", "epoch": e, "kind": "station-keeping", "dv": None}
                        for k, e in enumerate(case.station_keeping_epochs())], key=lambda m: m["epoch"])
@@ -96,7 +97,7 @@ def simulate_truth(case, ephemeris, rng) -> Truth:
         fm = replace(nominal, components=components + [ImpulsiveManeuver(e, dv) for e, dv in executed])
         if m["dv"] is None:
             state = propagate(x0, t0, t, fm, with_stm=False).state(t)[0]
-            m["dv"] = design_dv(nominal, state, t, gap, horizon)
+            m["dv"] = design_dv(nominal, state, t, gaps, horizon)
         executed.append((t, executed_dv(m["dv"], float(ex["sigma_magnitude"]),
                                         np.radians(float(ex["sigma_pointing_deg"])), rng)[0]))
     fm = replace(nominal, components=components + [ImpulsiveManeuver(e, dv) for e, dv in executed])
