@@ -241,11 +241,17 @@ def _table(rec: pd.DataFrame, source: str) -> pd.DataFrame:
     )
 
 
+MAX_COUNT_GAP = 10  # data intervals
+
+
 def _doppler(col, cnt, valid, interval, factor_m, epoch):
     """Doppler shift (Hz) and count time (s) per record from the running or destruct count.
 
     A running count is differenced with the previous record of the same SIC,
-    VID and receive pad that carries one.
+    VID and receive pad that carries one, if that record is at most
+    ``MAX_COUNT_GAP`` data intervals earlier: a counter is not known to run on
+    across a gap between passes, so the first record after one starts a new
+    series (NaN), like the first record of a file.
     """
     has = ((valid & 2) != 0) | (cnt != 0)
     destruct = (valid & 64) != 0
@@ -259,7 +265,7 @@ def _doppler(col, cnt, valid, interval, factor_m, epoch):
     p = np.where(has_prev, prev, 0)
     dt = (epoch - epoch[p]).astype(np.int64) / 1e9
     dn = (cnt - cnt[p]) % COUNT_WRAP
-    ok = has_prev & (dt > 0)
+    ok = has_prev & (dt > 0) & (dt <= MAX_COUNT_GAP * interval)
     with np.errstate(invalid="ignore", divide="ignore"):
         from_running = (dn / dt - DOPPLER_BIAS_HZ) / factor_m
         from_destruct = (cnt / interval - DOPPLER_BIAS_HZ) / factor_m

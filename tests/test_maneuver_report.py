@@ -4,7 +4,7 @@ import numpy as np
 import pandas as pd
 import pytest
 
-from odpipe.analysis.maneuvers import evaluate
+from odpipe.analysis.maneuvers import evaluate, flatten
 
 
 def test_table_4_4_figures_by_hand():
@@ -14,7 +14,7 @@ def test_table_4_4_figures_by_hand():
         "estimated": [np.array([0.303, 0.396, 0.001]), np.array([0.002, 0.0, -0.19])],
         "sigma": [np.array([1e-3, 1e-3, 1e-3]), np.array([2e-3, 2e-3, 2e-3])],
     })
-    rows, stats = evaluate(table)
+    rows, stats = evaluate(flatten(table))
     # SK1: |d| = 0.5, |e| = sqrt(0.303^2+0.396^2+0.001^2) = 0.498630...
     e1 = np.sqrt(0.303**2 + 0.396**2 + 0.001**2)
     assert rows.loc[0, "Mag. (mm/s)"] == pytest.approx(abs(0.5 - e1) * 1e3, rel=1e-12)

@@ -112,3 +112,16 @@ def test_overlap_command_on_oem_products(tmp_path):
     table = pd.read_csv(tmp_path / "ov" / "overlaps.csv")
     assert table["pos_crosstrack_rms"].iloc[:2].tolist() == pytest.approx([5.0, 10.0], abs=1e-3)
     assert (tmp_path / "ov" / "overlap_velocity.png").exists()
+
+
+def test_piecewise_trajectory_switches_at_the_maneuver():
+    from odpipe.analysis.overlap import PiecewiseTrajectory
+
+    t1 = np.arange(0.0, 3601.0, 60.0)
+    t2 = np.arange(3600.0, 7201.0, 60.0)
+    x2 = circular(t2)
+    x2[:, 3] += 0.01  # a 1 cm/s burn at 3600 s
+    traj = PiecewiseTrajectory([SampledTrajectory(t2, x2), SampledTrajectory(t1, circular(t1))])
+    assert (traj.t0, traj.t1) == (0.0, 7200.0)
+    assert traj.state(3600.0)[0, 3] == pytest.approx(circular(np.array([3600.0]))[0, 3] + 0.01)
+    assert traj.state(3599.0)[0, 3] == pytest.approx(circular(np.array([3599.0]))[0, 3], abs=1e-9)

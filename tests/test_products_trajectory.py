@@ -116,3 +116,16 @@ def test_failed_write_leaves_previous_product(tmp_path, segment):
         write_spk(path, [bad], -999)
     assert path.read_bytes() == before
     assert [p.name for p in tmp_path.iterdir()] == ["sat.bsp"]
+
+
+def test_spk_trajectory_reads_back_what_was_written(tmp_path, segment):
+    from odpipe.products.spk import SpkTrajectory
+
+    path = tmp_path / "ref.bsp"
+    write_spk(path, [segment], -998)
+    ref = SpkTrajectory(path, -998)
+    try:
+        assert (ref.t0, ref.t1) == (segment.t_tdb[0], segment.t_tdb[-1])
+        assert np.max(np.abs(ref.state(segment.t_tdb[::17]) - segment.states[::17])) < 1e-6
+    finally:
+        sp.unload(str(path))

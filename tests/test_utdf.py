@@ -203,3 +203,17 @@ def test_fuzz_only_parse_errors(utdf_head, tmp_path_factory, data):
         assert len(d.meta["records"]) <= len(buf) // 75
         assert utdf.encode(d.meta["records"]) == b"".join(
             bytes(buf[i * 75:(i + 1) * 75]) for i in d.meta["records"].index)
+
+
+def test_running_count_is_not_differenced_across_a_pass_gap(tmp_path):
+    # The writer's records twice, a day apart: the first record of the second pass starts a new
+    # series instead of averaging the Doppler over the whole gap between passes.
+    recs = _fixture_cases()
+    later = recs.copy()
+    later["seconds_of_year"] = later["seconds_of_year"] + 86400
+    utdf.write(tmp_path / "two_passes.utdf", pd.concat([recs, later], ignore_index=True))
+    dop = utdf.read(tmp_path / "two_passes.utdf").table
+    dop = dop[dop["observable"] == "doppler_2way"].reset_index(drop=True)
+    n = len(dop) // 2
+    assert np.isnan(dop["value"].iloc[n])
+    np.testing.assert_array_equal(dop["count_time"].iloc[n + 1:], dop["count_time"].iloc[1:n])

@@ -21,12 +21,28 @@ def _nonzero(x: np.ndarray) -> np.ndarray:
     return np.where(x > 0, x, np.nan)
 
 
+def flatten(table: pd.DataFrame) -> pd.DataFrame:
+    """A maneuver table with 3-vector columns (``designed``, ``estimated``, ``sigma``, ...) as
+    flat ``<name>_x|y|z`` columns, the form written to CSV."""
+    out = pd.DataFrame(index=table.index)
+    for col in table.columns:
+        values = table[col].to_numpy()
+        if len(values) and isinstance(values[0], np.ndarray) and values[0].shape == (3,):
+            for i, axis in enumerate("xyz"):
+                out[f"{col}_{axis}"] = [float(v[i]) for v in values]
+        else:
+            out[col] = values
+    return out
+
+
+def _vectors(table: pd.DataFrame, name: str) -> np.ndarray:
+    return table[[f"{name}_{a}" for a in "xyz"]].to_numpy(float)
+
+
 def evaluate(table: pd.DataFrame) -> tuple[pd.DataFrame, pd.DataFrame]:
-    """(per-maneuver rows, Average/Median/Max/Min summary) from columns ``maneuver``,
-    ``designed``, ``estimated`` (3-vectors, m/s) and ``sigma`` (3-vector, m/s)."""
-    d = np.stack(table["designed"].to_numpy()).astype(float)
-    e = np.stack(table["estimated"].to_numpy()).astype(float)
-    s = np.stack(table["sigma"].to_numpy()).astype(float)
+    """(per-maneuver rows, Average/Median/Max/Min summary) from a flat table (:func:`flatten`):
+    ``maneuver``, ``designed_x|y|z``, ``estimated_x|y|z`` and ``sigma_x|y|z`` (m/s)."""
+    d, e, s = _vectors(table, "designed"), _vectors(table, "estimated"), _vectors(table, "sigma")
     dmag, emag = np.linalg.norm(d, axis=1), np.linalg.norm(e, axis=1)
     unit = e / np.where(emag > 0, emag, 1.0)[:, None]
     rows = pd.DataFrame({"maneuver": table["maneuver"].to_numpy(),

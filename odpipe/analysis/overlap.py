@@ -42,6 +42,24 @@ class SampledTrajectory:
         return np.hstack([self._spline(t), self._dspline(t)])
 
 
+class PiecewiseTrajectory:
+    """Consecutive trajectories (e.g. OEM segments split at maneuvers) as one; at a shared
+    boundary epoch the later piece (after the maneuver) answers."""
+
+    def __init__(self, pieces):
+        self.pieces = sorted(pieces, key=lambda p: p.t0)
+        self.t0, self.t1 = self.pieces[0].t0, self.pieces[-1].t1
+        self._starts = np.array([p.t0 for p in self.pieces])
+
+    def state(self, t_tdb):
+        t = np.atleast_1d(np.asarray(t_tdb, dtype=float))
+        k = np.clip(np.searchsorted(self._starts, t, side="right") - 1, 0, len(self.pieces) - 1)
+        out = np.empty((t.size, 6))
+        for j in np.unique(k):
+            out[k == j] = self.pieces[j].state(t[k == j])
+        return out
+
+
 @dataclass
 class Overlap:
     """Differences (A − B) over one overlap: ``t_tdb`` (N,), ``dr_ric`` (N,3) m, ``dv_ric`` (N,3) m/s."""

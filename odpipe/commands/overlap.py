@@ -6,7 +6,7 @@ from pathlib import Path
 
 import numpy as np
 
-from odpipe.analysis.overlap import SampledTrajectory, compare, plot_overlaps, summarize
+from odpipe.analysis.overlap import PiecewiseTrajectory, SampledTrajectory, compare, plot_overlaps, summarize
 from odpipe.products.atomic import write_text
 from odpipe.time import utc_to_tdb
 from parsers import oem
@@ -23,17 +23,19 @@ def add_arguments(p):
     p.add_argument("--step", type=float, default=600.0, help="comparison grid step (s)")
 
 
-def trajectory_from_oem(path) -> SampledTrajectory:
-    """The first segment of an OEM as a trajectory in TDB seconds past J2000 (m, m/s)."""
-    seg = oem.read(path)[0]
-    scale = seg.meta.get("TIME_SYSTEM", "UTC")
-    if scale == "TDB":
-        t = (seg.epochs - _J2000) / np.timedelta64(1, "s")
-    elif scale == "UTC":
-        t = utc_to_tdb(seg.epochs)
-    else:
-        raise ValueError(f"{path}: TIME_SYSTEM {scale} not supported (TDB or UTC)")
-    return SampledTrajectory(t, seg.states)
+def trajectory_from_oem(path) -> PiecewiseTrajectory:
+    """All segments of an OEM as one trajectory in TDB seconds past J2000 (m, m/s)."""
+    pieces = []
+    for seg in oem.read(path):
+        scale = seg.meta.get("TIME_SYSTEM", "UTC")
+        if scale == "TDB":
+            t = (seg.epochs - _J2000) / np.timedelta64(1, "s")
+        elif scale == "UTC":
+            t = utc_to_tdb(seg.epochs)
+        else:
+            raise ValueError(f"{path}: TIME_SYSTEM {scale} not supported (TDB or UTC)")
+        pieces.append(SampledTrajectory(t, seg.states))
+    return PiecewiseTrajectory(pieces)
 
 
 def run(args) -> int:

@@ -63,8 +63,10 @@ def calibrate(table: pd.DataFrame, model: MediaModel, *, target_itrs=None, ramps
     start, end = interval_bounds(epoch, ct, out["tag"].to_numpy())
     rtlt, rtlt_note = _round_trip(out, target_itrs, catalog, epoch)
 
-    f_up, f_down, f_up_known = _frequencies(out, epoch - np.rint(rtlt * 1e9).astype(np.int64), ramps)
-    s = _samples(out, obs, ground, doppler, epoch, start, end, rtlt, f_up, f_down)
+    # rows without geometry (NaN light time) get no direction either, so no correction: 0 is a placeholder
+    rtlt_ns = np.rint(np.nan_to_num(rtlt) * 1e9).astype(np.int64)
+    f_up, f_down, f_up_known = _frequencies(out, epoch - rtlt_ns, ramps)
+    s = _samples(out, obs, ground, doppler, epoch, start, end, rtlt_ns, f_up, f_down)
     tropo, iono, lab_t, lab_i = _leg_delays(s, out, model, target_itrs, catalog)
     if order is not None and len(s):
         group = pd.MultiIndex.from_arrays([s["pass_id"], s["leg"], s["station"]]).codes
@@ -92,7 +94,7 @@ def calibrate(table: pd.DataFrame, model: MediaModel, *, target_itrs=None, ramps
     return out, pass_report(out)
 
 
-def _samples(t, obs, ground, doppler, epoch, start, end, rtlt, f_up, f_down) -> pd.DataFrame:
+def _samples(t, obs, ground, doppler, epoch, start, end, rtlt_ns, f_up, f_down) -> pd.DataFrame:
     """One sample per (row, leg, instant): the station, its ground time (ns) and the leg frequency.
 
     Range rows have one instant (the tag); Doppler rows two, the count's end (sign +1) and
@@ -102,7 +104,7 @@ def _samples(t, obs, ground, doppler, epoch, start, end, rtlt, f_up, f_down) -> 
     up_rows = ground & np.isin(obs, TWO_LEG)
     for leg, stations, freq, leg_rows, shift in (("down", t["station_rx"], f_down, ground, 0),
                                                  ("up", t["station_tx"], f_up, up_rows,
-                                                  np.rint(rtlt * 1e9).astype(np.int64))):
+                                                  rtlt_ns)):
         for sign, at in ((1.0, np.where(doppler, end, epoch)), (-1.0, start)):
             rows = np.flatnonzero(leg_rows & ((sign > 0) | doppler))
             parts.append(pd.DataFrame({"row": rows, "leg": leg, "sign": sign,

@@ -51,7 +51,7 @@ class ArcSetup:
     force_model: dynamics without the estimated maneuvers and stochastic accelerations.
     srp_scale_sigma: a priori sigma of the SRP scale (None: not estimated).
     stochastic: RTN Gauss-Markov accelerations (m/s^2; tau 0 = white per batch), or None.
-    data_sigma: observable -> sigma along the line of sight (m or m/s).
+    data_sigma: sigma along the line of sight (m or m/s) by "observable:station_rx", else by "observable".
     range_bias_sigma: per pass and receiving station (m; None: no biases; pass_id -1 = one per station).
     oscillator_sigma: (Hz, Hz/s) of the one-way oscillator bias and drift, when doppler_1way is fitted.
     station_sigma: considered (not estimated) error of each station's ITRS coordinates (m per axis).
@@ -110,6 +110,12 @@ class ArcSolution:
     problem: TrackingProblem
 
 
+def data_sigma(rows: pd.DataFrame, sigmas: dict) -> np.ndarray:
+    """Per-row sigma (m or m/s): the "observable:station_rx" entry if there is one, else the observable's."""
+    by_station = (rows["observable"] + ":" + rows["station_rx"].astype(str)).map(sigmas)
+    return by_station.fillna(rows["observable"].map(sigmas)).to_numpy(float)
+
+
 def reception_times(rows: pd.DataFrame) -> np.ndarray:
     """TDB s of each row's last reception (interval end for count-averaged rows)."""
     _, end = interval_bounds(rows["epoch"].to_numpy("datetime64[ns]").astype(np.int64),
@@ -119,7 +125,7 @@ def reception_times(rows: pd.DataFrame) -> np.ndarray:
 
 def select_rows(table: pd.DataFrame, setup: ArcSetup) -> tuple[pd.DataFrame, np.ndarray]:
     """Rows of the arc in reception-time order (original index kept) and their TDB times."""
-    sel = ((table["flags"].to_numpy() == 0) & table["observable"].isin(list(setup.data_sigma)).to_numpy()
+    sel = ((table["flags"].to_numpy() == 0) & table["observable"].isin([k.split(":")[0] for k in setup.data_sigma]).to_numpy()
            & (table["spacecraft"].astype(str).to_numpy() == setup.spacecraft))
     rows = table[sel]
     t = reception_times(rows)
@@ -194,7 +200,7 @@ def fit_arc(table: pd.DataFrame, setup: ArcSetup) -> ArcSolution:
     if not good.all():
         problem = problem_for(rows[good], times[good])
     used = rows[good]
-    sig = used["observable"].map(setup.data_sigma).to_numpy(float) / to_los[good]
+    sig = data_sigma(used, setup.data_sigma) / to_los[good]
     group = (used["observable"] + ":" + used["station_rx"].astype(str)).to_numpy(object)
     obs = Observations(times[good], used["value"].to_numpy(float), sig, group)
     sol = fit(problem, obs, setup.start, setup.end, options)

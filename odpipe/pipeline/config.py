@@ -32,6 +32,7 @@ class ArcSection:
 @dataclass
 class DataSection:
     files: list[Path]
+    stations: list[Path] = field(default_factory=list)  # station CSVs added to the default catalog
     observables: list[str] = field(default_factory=lambda: ["doppler_2way", "range"])
     errors: Literal["raise", "report"] = "report"  # nightly: report a corrupt record and go on
 
@@ -108,12 +109,13 @@ class EstimationSection:
     sigma_velocity: float = 1.0
     srp_scale_sigma: float | None = 0.1
     stochastic: StochasticSection | None = None
+    # LOS sigma (m, m/s) by "observable" or "observable:station" (the station's entry wins)
     data_sigma: dict[str, float] = field(default_factory=lambda: {"range": 2.0, "doppler_2way": 1e-4})
     range_bias_sigma: float | None = 5.0
     maneuver_plan: Path | None = None  # planned maneuvers (parsers.maneuvers schema)
     edit_k: list[float] = field(default_factory=lambda: [float("inf"), 10.0, 5.0])
     max_iter: int = 10
-    reweight: bool = True
+    reweight: bool = False  # ARTEMIS reweighting from post-fit RMS; see README (known instability)
     block: float = 600.0
 
 

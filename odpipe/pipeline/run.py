@@ -18,7 +18,6 @@ import numpy as np
 import pandas as pd
 
 from odpipe.analysis import maneuvers as maneuver_report
-from odpipe.environment.stations import StationCatalog
 from odpipe.media.apply import calibrate
 from odpipe.media.ionosphere import IonexModel
 from odpipe.media.model import MediaModel
@@ -88,8 +87,8 @@ def _run(cfg: RunConfig, attempt, log: RunLog) -> dict:
         f"({', '.join(f'{k} {v}' for k, v in table['observable'].value_counts().items())})")
 
     fm = build.force_model(cfg)
-    setup = build.arc_setup(cfg, fm, data.store)
-    catalog = StationCatalog.default()
+    catalog = build.station_catalog(cfg)
+    setup = build.arc_setup(cfg, fm, data.store, catalog)
     apriori = build.a_priori_trajectory(setup)
     table = add_geometry(table, apriori, fm.ephemeris, catalog)
     log(f"geometry: elevation and light time from the a priori trajectory ({apriori.n_steps} steps)")
@@ -135,7 +134,7 @@ def _products(cfg, attempt, log, table, arc, edits, fit_seconds) -> dict:
     write_text(attempt.product("parameters.csv"), params.to_csv(index=False))
     man_rows = man_stats = None
     if len(arc.maneuvers):
-        mt = arc.maneuvers
+        mt = maneuver_report.flatten(arc.maneuvers)
         write_text(attempt.product("maneuvers.csv"), mt.to_csv(index=False))
         man_rows, man_stats = maneuver_report.evaluate(mt)
         write_text(attempt.product("maneuver_evaluation.csv"), man_stats.to_csv())

@@ -79,14 +79,22 @@ def _vnb_matrix(x):
     return np.array([v, n, np.cross(v, n)])
 
 
-def arc_setup(cfg: RunConfig, fm: F.ForceModel, ramps) -> ArcSetup:
+def station_catalog(cfg: RunConfig) -> StationCatalog:
+    """The default catalog plus the run's own station files."""
+    catalog = StationCatalog.default()
+    for path in cfg.data.stations:
+        catalog = catalog.with_csv(path)
+    return catalog
+
+
+def arc_setup(cfg: RunConfig, fm: F.ForceModel, ramps, catalog: StationCatalog) -> ArcSetup:
     est = cfg.estimation
     start, end = tdb(cfg.arc.start), tdb(cfg.arc.end)
     t_state = tdb(cfg.initial_state.epoch)
     state0 = np.asarray(cfg.initial_state.state, float)
     if abs(t_state - start) > 1e-6:  # move the a priori state to the arc start
         state0 = propagate(state0, t_state, start, fm, with_stm=False).state(start)[0]
-    meas = MeasurementSetup(fm.ephemeris, StationCatalog.default(), ramps=ramps, gcrs_to_itrs=gcrs_to_itrs)
+    meas = MeasurementSetup(fm.ephemeris, catalog, ramps=ramps, gcrs_to_itrs=gcrs_to_itrs)
     stochastic = None if est.stochastic is None else GaussMarkov(est.stochastic.tau, est.stochastic.sigma,
                                                                  est.stochastic.batch)
     return ArcSetup(spacecraft=cfg.arc.spacecraft, start=start, end=end, state0=state0, force_model=fm,
@@ -107,7 +115,7 @@ def a_priori_trajectory(setup: ArcSetup):
 
 def input_files(cfg: RunConfig) -> list:
     """Every file whose bytes decide the run's result."""
-    files = list(cfg.data.files) + cfg.calibration.tro + cfg.calibration.ion + cfg.calibration.ionex
+    files = list(cfg.data.files) + cfg.data.stations + cfg.calibration.tro + cfg.calibration.ion + cfg.calibration.ionex
     files += [g.file for g in cfg.dynamics.gravity]
     if cfg.estimation.maneuver_plan is not None:
         files.append(cfg.estimation.maneuver_plan)

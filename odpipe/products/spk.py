@@ -40,3 +40,25 @@ def write_spk(path, segments: list[EphemerisSegment], body_id: int, *, degree: i
                           np.ascontiguousarray(seg.t_tdb))
         finally:
             sp.spkcls(handle)
+
+
+class SpkTrajectory:
+    """A body's trajectory from an SPK file through SPICE (e.g. a reference or truth ephemeris).
+
+    ``state(t_tdb) -> (N,6)`` m, m/s in ICRF axes about ``center``; ``t0``, ``t1``
+    bound the file's coverage of the body (s TDB).
+    """
+
+    def __init__(self, path, body_id: int, center: str = "earth"):
+        self.path, self.body, self.center = str(path), int(body_id), center
+        sp.furnsh(self.path)
+        cover = sp.spkcov(self.path, self.body)
+        windows = [sp.wnfetd(cover, i) for i in range(sp.wncard(cover))]
+        if not windows:
+            raise ValueError(f"{path}: no SPK data for body {body_id}")
+        self.t0, self.t1 = windows[0][0], windows[-1][1]
+
+    def state(self, t_tdb) -> np.ndarray:
+        t = np.atleast_1d(np.asarray(t_tdb, float))
+        center = NAIF_IDS[self.center]
+        return np.array([sp.spkgeo(self.body, float(x), "J2000", center)[0] for x in t]) * 1e3
