@@ -130,8 +130,26 @@ def test_same_seed_same_bytes(sim, tmp_path):
 
     paths, _, _ = sim
     again, _, _ = run_case(CASE, tmp_path, days=DAYS)
-    for role in ("trk234", "utdf:BGS", "tro", "maneuvers", "spk"):
+    for role in ("trk234", "utdf:BGS", "utdf:USHS", "tro", "maneuvers", "maneuvers_executed", "spk", "table", "ramps"):
         assert hashlib.sha256(paths[role].read_bytes()).digest() == hashlib.sha256(again[role].read_bytes()).digest(), role
+    # the OEM writer stamps its CREATION_DATE: everything else is identical
+    lines = [[ln for ln in p["oem"].read_text().splitlines() if not ln.startswith("CREATION_DATE")] for p in (paths, again)]
+    assert lines[0] == lines[1]
+
+
+def test_another_seed_other_noise(sim, tmp_path):
+    from odpipe.simulate.case import load
+
+    paths, _, obs = sim
+    text = CASE.read_text().replace("seed = 20101120", "seed = 7")
+    other = tmp_path / "other.toml"
+    other.write_text(text)
+    from odpipe.simulate import run_case
+
+    _, _, obs2 = run_case(other, tmp_path / "out", days=DAYS)
+    assert load(other).seed == 7
+    n = min(len(obs.errors), len(obs2.errors))
+    assert not np.allclose(obs.errors["noise"][:n], obs2.errors["noise"][:n])
 
 
 def test_usn_range_reads_back(sim):
