@@ -190,3 +190,25 @@ def test_executed_maneuvers_differ_from_design_by_the_error_model():
     ang = np.arccos(np.clip(e @ d[0] / np.linalg.norm(e, axis=1) / np.linalg.norm(d[0]), -1, 1))
     assert abs(mag.std() - 0.02) < 0.002
     assert abs(np.sqrt(np.mean(ang**2)) - np.radians(2.0)) < np.radians(0.1)
+
+
+def test_models_reproduce_the_utdf_files(sim):
+    """Rows as the UTDF reader gives them, computed by odpipe.measurements on the truth, equal the file's values
+    less the simulated media, noise, bias and spin (to the encodings' rounding)."""
+    from odpipe.simulate.schedule import StateOnly
+
+    paths, truth, obs = sim
+    setup = _setup(obs)
+    for role, station in (("utdf:BGS", "BGS"), ("utdf:USHS", "USHS")):
+        rows = utdf.read(paths[role]).table.reset_index(drop=True)
+        ev = compute(rows, {"2": StateOnly(truth.trajectory)}, setup)
+        sim_rows = (obs.table["station_rx"] == station).to_numpy()
+        e = obs.errors[sim_rows].reset_index(drop=True)
+        t = obs.table[sim_rows].reset_index(drop=True)
+        key = t["epoch"].astype("int64") * 2 + (t["observable"] == "range")
+        rkey = rows["epoch"].astype("int64") * 2 + (rows["observable"] == "range")
+        e = e.set_index(key.to_numpy()).loc[rkey.to_numpy()]
+        clean = rows["value"].to_numpy() - (e["media"] + e["noise"] + e["bias"] + e["spin"]).to_numpy()
+        is_range = (rows["observable"] == "range").to_numpy()
+        tol = np.where(is_range, 0.5 / 256e9, 5e-5) + 1e-12
+        assert np.all(np.abs(clean - ev.value) <= tol * 1.01), role
