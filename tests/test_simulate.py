@@ -108,7 +108,7 @@ def test_noise_sigma_within_chi2_bounds(sim):
 
 def test_tro_calibration_removes_the_added_media(sim):
     paths, _, obs = sim
-    cal = read_trk223(paths["tro"])
+    cal = read_trk223(paths["tro"], paths["ion"])
     t = obs.table.drop(columns=["media_m"])
     from odpipe.environment.stations import StationCatalog
 
@@ -116,7 +116,9 @@ def test_tro_calibration_removes_the_added_media(sim):
     out, _ = calibrate(t, MediaModel(cal), ramps=obs.ramps, catalog=catalog, order=None)
     np.testing.assert_allclose(np.nan_to_num(out["media_m"]), np.nan_to_num(obs.table["media_m"]), atol=1e-12)
     dsn = t["station_rx"].str.startswith("DSS").to_numpy()
-    assert out["media_source"][dsn].str.contains(".TRO").all()
+    src = out["media_source"][dsn].astype(str)
+    assert src.str.contains(".TRO").all() and src.str.contains(".ION").all()
+    assert (out["iono_m"][dsn & (t["observable"] == "range").to_numpy()] > 0).all()   # group delay on range
     assert np.nanmax(np.abs(obs.errors["media"])) > 0      # the delays were really added
 
 
@@ -130,7 +132,7 @@ def test_same_seed_same_bytes(sim, tmp_path):
 
     paths, _, _ = sim
     again, _, _ = run_case(CASE, tmp_path, days=DAYS)
-    for role in ("trk234", "utdf:BGS", "utdf:USHS", "tro", "maneuvers", "maneuvers_executed", "spk", "table", "ramps"):
+    for role in ("trk234", "utdf:BGS", "utdf:USHS", "tro", "ion", "maneuvers", "maneuvers_executed", "spk", "table", "ramps"):
         assert hashlib.sha256(paths[role].read_bytes()).digest() == hashlib.sha256(again[role].read_bytes()).digest(), role
     # the OEM writer stamps its CREATION_DATE: everything else is identical
     lines = [[ln for ln in p["oem"].read_text().splitlines() if not ln.startswith("CREATION_DATE")] for p in (paths, again)]

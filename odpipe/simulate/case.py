@@ -11,7 +11,8 @@ Schema (SI units unless the key says otherwise; times UTC ISO 8601)::
                    (designed at run time: perpendicular x-z crossing after gap, see odpipe.simulate.stationkeeping)
     [[maneuver]]   name, epoch, kind (e.g. 'attitude'), dv ([x,y,z] ICRF m/s, designed)
     [execution]    sigma_magnitude (fraction), sigma_pointing_deg (per maneuver)
-    [media]        sigma_wet_m, sigma_dry_m (per-day deviations from the DSN seasonal model)
+    [media]        sigma_wet_m, sigma_dry_m (per-day deviations from the DSN seasonal model),
+                   sigma_ion_m (S-band line-of-sight delay scale per DSN pass)
     [[network]]    station, format ('trk234'|'utdf'), pad (UTDF pad id), band, uplink_hz,
                    every_days, offset_days, passes (per tracking day), pass_s, mask_deg,
                    doppler_count_s, sigma_doppler (m/s), range_step_s (0: no range),

@@ -116,8 +116,8 @@ def maneuver_plan(maneuvers, dv=None) -> pd.DataFrame:
     return plan
 
 
-def write_case(out: Path, case, truth, obs, tro_text: str, setup, stations_csv: Path, step_s: float = 600.0) -> dict:
-    """Write every product of a simulated case into ``out``; returns {role: path}."""
+def write_case(out: Path, case, truth, obs, calibrations: dict, setup, stations_csv: Path, step_s: float = 600.0) -> dict:
+    """Write every product of a simulated case into ``out`` (``calibrations``: {'tro'|'ion': TRK-2-23 text}); {role: path}."""
     out.mkdir(parents=True, exist_ok=True)
     sc = case.spacecraft
     t = obs.table
@@ -144,8 +144,9 @@ def write_case(out: Path, case, truth, obs, tro_text: str, setup, stations_csv: 
     ramps.to_parquet(paths["ramps"])
     paths["errors"] = out / "simulated_errors.parquet"
     obs.errors.to_parquet(paths["errors"])
-    paths["tro"] = out / f"{case.name}.TRO"
-    paths["tro"].write_text(tro_text)
+    for kind, text in calibrations.items():
+        paths[kind] = out / f"{case.name}.{kind.upper()}"
+        paths[kind].write_text(text)
     paths["maneuvers"] = out / "maneuvers_designed.csv"
     write_plan(maneuver_plan(truth.maneuvers), paths["maneuvers"])
     paths["maneuvers_executed"] = out / "maneuvers_executed_truth.csv"

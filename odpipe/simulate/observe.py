@@ -3,7 +3,7 @@
 Per row: value = model(truth, media) + (noise + range bias + spin) / to_los, where
 the media delay is what :func:`odpipe.media.apply.calibrate` gives for the row
 (troposphere from the TRK-2-23 .TRO cards on the DSN seasonal model, standard
-atmosphere elsewhere; Niell mapping) and enters through the table's ``media_m``
+atmosphere elsewhere, Niell mapping; ionosphere from the .ION cards of DSN passes) and enters through the table's ``media_m``
 column and the models' own media term. Noise is white along the line of sight
 (m, m/s), the range bias one draw per pass, the spin signature the
 count-averaged rate of a = antenna_offset * sin(w t + phi). Doppler is
@@ -55,6 +55,7 @@ def _ramp(net, window, rng) -> dict:
 
 def plan_rows(case, traj, setup, rng) -> tuple[pd.DataFrame, pd.DataFrame]:
     """(rows without values, ramp table) of every network's passes."""
+    traj = StateOnly(traj)
     sc = str(case.spacecraft)
     parts, ramps, pid = [], [], 0
     for net in case.networks:
@@ -87,10 +88,17 @@ def spin_signature(t_s: np.ndarray, count: np.ndarray, amplitude: float, rate: f
     return amplitude * (np.sin(rate * t_s + phase) - np.sin(rate * (t_s - count) + phase)) / count
 
 
-def observe(case, traj, setup, media_model, catalog, rng) -> Observations:
-    """Simulate every network's observables of ``traj`` (setup.ramps is set from the simulated ramps)."""
+def dsn_passes(table) -> list[tuple]:
+    """(station, first tag, last tag) of each DSN pass of a planned table (for the .ION cards)."""
+    dsn = table[table["station_rx"].str.startswith("DSS-")]
+    g = dsn.groupby("pass_id")
+    return list(zip(g["station_rx"].first(), g["epoch"].min().to_numpy("datetime64[ns]"),
+                    g["epoch"].max().to_numpy("datetime64[ns]")))
+
+
+def observe(case, table, ramps, traj, setup, media_model, catalog, rng) -> Observations:
+    """Values and errors of planned rows (:func:`plan_rows`) of ``traj``; sets setup.ramps from ``ramps``."""
     traj = StateOnly(traj)
-    table, ramps = plan_rows(case, traj, setup, rng)
     setup.ramps = RampStore(ramps) if len(ramps) else None
     table = pd.concat([table, geometry(table, traj, setup)], axis=1)
     cal, _ = calibrate(table, media_model, ramps=ramps if len(ramps) else None, catalog=catalog, order=None)

@@ -13,8 +13,8 @@ from odpipe.measurements import MeasurementSetup
 from odpipe.media.model import MediaModel
 from odpipe.simulate.case import load
 from odpipe.simulate.files import write_case
-from odpipe.simulate.observe import observe
-from odpipe.simulate.troposphere import tro_text
+from odpipe.simulate.calibrations import ion_text, tro_text
+from odpipe.simulate.observe import dsn_passes, observe, plan_rows
 from odpipe.simulate.truth import simulate_truth
 from parsers.trk223 import CalibrationSet, parse_text
 
@@ -31,9 +31,11 @@ def run_case(case_path, out, days: float | None = None, stations_csv: Path = STA
     catalog = StationCatalog.default().with_csv(stations_csv)
     setup = MeasurementSetup(eph, catalog, gcrs_to_itrs=gcrs_to_itrs)
     truth = simulate_truth(case, eph, rng)
+    table, ramps = plan_rows(case, truth.trajectory, setup, rng)
     tro = tro_text([n.station for n in case.networks], case.start, case.end, float(case.media["sigma_wet_m"]),
                    float(case.media["sigma_dry_m"]), rng)
-    model = MediaModel(CalibrationSet(parse_text(tro, f"{case.name}.TRO")))
-    obs = observe(case, truth.trajectory, setup, model, catalog, rng)
-    paths = write_case(Path(out), case, truth, obs, tro, setup, stations_csv)
+    ion = ion_text(dsn_passes(table), case.spacecraft, float(case.media["sigma_ion_m"]), rng)
+    model = MediaModel(CalibrationSet(parse_text(tro, f"{case.name}.TRO") + parse_text(ion, f"{case.name}.ION")))
+    obs = observe(case, table, ramps, truth.trajectory, setup, model, catalog, rng)
+    paths = write_case(Path(out), case, truth, obs, {"tro": tro, "ion": ion}, setup, stations_csv)
     return paths, truth, obs
