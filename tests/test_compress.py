@@ -255,3 +255,23 @@ def test_grail_odf_compression(shared_data):
     print(f"GRAIL 101 1-way: rms 1 s {rms1:.4f} Hz, rms 60 s {rms60:.4f} Hz, ratio {rms1 / rms60:.2f}")
     assert len(r60) > 100
     assert rms1 / np.sqrt(60) < rms60 < rms1
+
+
+def test_running_doppler_counts_become_exact_doppler_in_hz():
+    # TRK-2-34 style: cycles of (Doppler + 1 MHz bias) accumulated from 0 at the first record, every 10 s
+    bias, dt = 1.0e6, 10.0
+    t_s = np.arange(0.0, 600.0 + dt, dt)
+    doppler = lambda t: 3000.0 + 2.0 * t + 50.0 * np.sin(t / 40.0)        # Hz, DSN sign
+    cycles = lambda t: (bias + 3000.0) * t + t**2 - 2000.0 * np.cos(t / 40.0) + 2000.0  # integral from 0
+    n = t_s.size
+    epoch = np.datetime64("2010-11-20T04:38:00", "ns") + (t_s * 1e9).astype("timedelta64[ns]")
+    tab = build(n, epoch=epoch, tag="interval_end", observable="doppler_count_2way", value=cycles(t_s), unit="cycles",
+                count_time=np.r_[0.0, np.full(n - 1, dt)], station_tx="DSS-24", station_rx="DSS-24",
+                spacecraft="2", band_up="S", band_down="S", pass_id=0, record=np.arange(n), doppler_bias_hz=bias)
+    out, _ = compress(tab, 60.0)
+    dop = out[out["observable"] == "doppler_2way"]
+    assert len(dop) == 10 and (dop["unit"] == "Hz").all() and (dop["count_time"] == 60.0).all()
+    start = (dop["epoch"].to_numpy() - epoch[0]) / np.timedelta64(1, "s") - 30.0   # tags are interval middles
+    exact = (cycles(start + 60.0) - cycles(start)) / 60.0 - bias
+    np.testing.assert_allclose(dop["value"], exact, atol=1e-6)
+    assert abs(exact[0] - doppler(start[0] + 30.0)) < 20.0  # the mean is near the mid-interval Doppler

@@ -99,7 +99,8 @@ def test_observables_match_pytrk234_fields(data):
         way = {2: "2way", 3: "3way"}[s["sec_chdo"]["prdx_mode"]]
         row = tab.loc[(i, f"doppler_count_{way}")]
         assert row["value"] == s["trk_chdo"]["dop_cnt"]
-        assert row["uplink_hz"] == s["trk_chdo"]["ul_freq"]
+        assert row["uplink_hz_record"] == s["trk_chdo"]["ul_freq"]  # the record's own value
+        assert row["ramped"] == (row["station_tx"] in set(data.ramps["station"]))
         assert row["count_time"] == s["sec_chdo"]["cnt_time"]
         assert row["station_rx"] == "DSS-25"
         assert row["transponder_ratio"] == pytest.approx(240 / 221, rel=1e-15)

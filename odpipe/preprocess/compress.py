@@ -3,7 +3,7 @@
 * Count-averaged Doppler (``doppler_*``, ``range_rate``, ``sst_doppler`` with a
   count time): N back-to-back count intervals average, weighted by their count
   times, to exactly the count-averaged Doppler over their union (unit Hz or
-  m/s). Doppler counts in cycles (TRK-2-34, TDM ``doppler_count*``) pass
+  m/s). Other Doppler counts in cycles (TDM ``doppler_count*``) pass
   through: whether a count is per interval or a running counter is the
   reader's to state.
 * Accumulated phase (``phase_*``, ``total_phase`` in cycles with no count time,
@@ -11,6 +11,9 @@
   ends of a window over its length is exactly the mean frequency (Hz) over it;
   the row becomes ``<observable>_rate`` tagged at the middle of the interval.
   (UTDF counters arrive already differenced into Hz by the UTDF reader.)
+* Running Doppler counts (TRK-2-34 ``doppler_count_<mode>``, cycles of the
+  biased Doppler tone): differenced the same way, less ``doppler_bias_hz``,
+  they become ``doppler_<mode>`` in Hz (DSN sign) over each window.
 
 Windows never span a gap (phase: a hole over twice the usual spacing), an
 overlap, a pass, an uplink ramp segment or a source file. Each segment's windows start at its first sample, so only a segment's last
@@ -72,6 +75,14 @@ def _is_phase(df: pd.DataFrame) -> np.ndarray:
     return ((obs.str.startswith("phase") | (obs == "total_phase")).to_numpy()
             & (df["unit"].to_numpy() == "cycles") & (df["count_time"].fillna(0).to_numpy() == 0)
             & (df["flags"].to_numpy() == 0))
+
+
+def _is_running_count(df: pd.DataFrame) -> np.ndarray:
+    """Running Doppler counts (TRK-2-34 ``doppler_count_<mode>``, cycles of the biased Doppler tone
+    accumulated since the start of a series; each record's count time is the time since the last)."""
+    return (df["observable"].astype(str).str.startswith("doppler_count_").to_numpy()
+            & (df["unit"].to_numpy() == "cycles") & (df["flags"].to_numpy() == 0)
+            & ("doppler_bias_hz" in df.columns))
 
 
 def _segments(df: pd.DataFrame, start, end, ramps, tol_ns, contiguous: bool, delay_ns: int):
@@ -233,7 +244,7 @@ def compress(table: pd.DataFrame, count_time: float = 60.0, *, ramps: pd.DataFra
     if (table["pass_id"] < 0).any():
         table = assign_passes(table, ramps, max_gap=max_gap, ramp_delay=ramp_delay)
     count_ns, tol_ns, delay_ns = (int(round(x * 1e9)) for x in (count_time, tol, ramp_delay))
-    avg, pha = _is_averaged(table), _is_phase(table)
+    avg, pha, cnt = _is_averaged(table), _is_phase(table), _is_running_count(table)
     report = CompressionReport(raw_rows=len(table))
     parts, dropped = [], []
     if avg.any():
@@ -244,6 +255,14 @@ def compress(table: pd.DataFrame, count_time: float = 60.0, *, ramps: pd.DataFra
         parts.append(rows)
         dropped.append(unused)
         report.phase_rows = len(rows)
+    if cnt.any():  # differenced like phase: mean biased Doppler over each window, less the bias
+        rows, unused = _compress_phase(table[cnt], ramps, count_ns, tol_ns, delay_ns)
+        rows["observable"] = rows["observable"].str.replace("doppler_count_", "doppler_", regex=False) \
+            .str.removesuffix("_rate")
+        rows["value"] = rows["value"] - rows["doppler_bias_hz"].to_numpy(float)
+        parts.append(rows)
+        dropped.append(unused)
+        report.phase_rows += len(rows)
     compressed = pd.concat(parts, ignore_index=True) if parts else None
     if compressed is not None:
         short = compressed["count_time"].to_numpy() < count_time - tol
@@ -256,7 +275,7 @@ def compress(table: pd.DataFrame, count_time: float = 60.0, *, ramps: pd.DataFra
                                          "record": np.concatenate(list(gone["source_records"])) if len(gone) else [],
                                          "reason": "partial window"}))
             compressed = compressed[~short]
-    rest = _passthrough(table[~(avg | pha)])
+    rest = _passthrough(table[~(avg | pha | cnt)])
     report.passthrough_rows = len(rest)
     out = pd.concat([p for p in (compressed, rest) if p is not None], ignore_index=True)
     out = out.sort_values(["epoch", "pass_id"], kind="stable").reset_index(drop=True)

@@ -38,4 +38,16 @@ def read(path, errors: str = "raise") -> TrackingData:
         counts[b.format_code] += len(b.records)
     spacecraft = sorted({int(s) for b in blocks for s in np.unique(b.records["scft_id"])})
     meta = {"format": "TRK-2-34", "sfdu_counts": counts, "spacecraft": spacecraft, "blocks": blocks}
-    return TrackingData(tracking_table(blocks, path.name), ramp_table(blocks, path.name), report, meta)
+    table, ramps = tracking_table(blocks, path.name), ramp_table(blocks, path.name)
+    return TrackingData(mark_ramped(table, ramps), ramps, report, meta)
+
+
+def mark_ramped(table, ramps):
+    """Rows uplinked by a station with ramp records in the file follow the ramp table: ``ramped``
+    True and ``uplink_hz`` NaN (the contract's form); the record's own frequency at the time tag
+    is kept in ``uplink_hz_record``."""
+    ramped = table["station_tx"].isin(set(ramps["station"])).to_numpy() & (table["station_tx"] != "").to_numpy()
+    table["uplink_hz_record"] = table["uplink_hz"]
+    table.loc[ramped, "ramped"] = True
+    table.loc[ramped, "uplink_hz"] = np.nan
+    return table

@@ -6,7 +6,7 @@ Rows per format code (``value`` in the format's own unit, named in ``unit``):
 - 1 downlink carrier phase: ``phase_downlink`` (cycles; sample 0 at the time tag)
 - 2/3 sequential ranging phase: ``range_phase_uplink`` / ``range_phase_downlink`` (RU)
 - 4/5 PN ranging phase: ``pn_phase_uplink`` / ``pn_phase_downlink`` (RU)
-- 6 Doppler count: ``doppler_count_1way/2way/3way`` (cycles), by the Doppler mode
+- 6 Doppler count: ``doppler_count_1way/2way/3way`` (cycles, tag 'interval_end'), by the Doppler mode
 - 7 sequential range and 14 PN range: ``range`` (RU)
 - 8 angles: ``angle_1`` and ``angle_2`` (rad from degrees; ``angle_type`` keeps the SIS code)
 - 11 DRVID: ``drvid`` (RU)
@@ -118,9 +118,10 @@ def _rows(block: Block) -> list[dict]:
         return [dict(base, observable=name, value=np.asarray(value(), np.float64), unit=unit, **extra)]
     if fc == 6:
         mode = np.array([_DOPPLER.get(int(m), "unknown") for m in range(256)], dtype=object)[r["prdx_mode"]]
+        # the count accumulates up to the time tag; count_time is the time since the previous count
         return [dict(base, observable=np.char.add("doppler_count_", mode.astype(str)).astype(object),
                      value=r["dop_cnt"].astype(np.float64), unit="cycles", uplink_hz=r["ul_freq"],
-                     doppler_bias_hz=r["dop_cnt_bias_freq"])]
+                     doppler_bias_hz=r["dop_cnt_bias_freq"], tag="interval_end")]
     if fc == 8:
         return [dict(base, observable=f"angle_{k}", value=r[f"ang{k}"].astype(np.float64) * _DEG, unit="rad",
                      angle_type=r["ang_type"].astype(np.int64)) for k in (1, 2)]
