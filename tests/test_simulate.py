@@ -214,3 +214,24 @@ def test_models_reproduce_the_utdf_files(sim):
         is_range = (rows["observable"] == "range").to_numpy()
         tol = np.where(is_range, 0.5 / 256e9, 5e-5) + 1e-12
         assert np.all(np.abs(clean - ev.value) <= tol * 1.01), role
+
+
+def test_passes_follow_the_cadence_rules(sim):
+    from odpipe.simulate.case import load
+
+    _, _, obs = sim
+    case = load(CASE)
+    t = obs.table[obs.table["observable"] == "doppler_2way"]
+    for net in case.networks:
+        rows = t[t["station_rx"] == net.station]
+        for _, p in rows.groupby("pass_id"):
+            start = p["epoch"].min() - np.timedelta64(int(net.doppler_count_s * 1e9), "ns")
+            length = (p["epoch"].max() - start) / np.timedelta64(1, "s")
+            day = (start - case.start) / np.timedelta64(1, "D")
+            k = (np.floor(day) - net.offset_days) / net.every_days
+            assert k == np.round(k) and k >= 0, (net.station, day)             # a tracking day of the rule
+            assert length <= net.pass_s
+            if np.floor(day) + 1 <= case.days:      # the whole tracking day inside the span: visibility is long enough
+                assert length == net.pass_s, (net.station, length)
+        per_day = rows.groupby(rows["epoch"].dt.floor("D"))["pass_id"].nunique()
+        assert (per_day <= net.passes).all()
