@@ -220,7 +220,7 @@ def test_passes_follow_the_cadence_rules(sim):
     from odpipe.simulate.case import load
 
     _, _, obs = sim
-    case = load(CASE)
+    case = load(CASE).shortened(DAYS)
     t = obs.table[obs.table["observable"] == "doppler_2way"]
     for net in case.networks:
         rows = t[t["station_rx"] == net.station]
