@@ -84,6 +84,9 @@ def run(cfg: dict, out, log=print) -> dict:
     rows = _rows(epochs[clear], cfg).reset_index(drop=True)
     times = t_rx[clear]
     ev = compute(rows, truth, meas)
+    if (ev.status != "").any():
+        raise RuntimeError(f"rows the models cannot compute: {set(ev.status[ev.status != ''])}")
+    to_los = float(np.unique(ev.to_los)[0])             # 1/2: round-trip path rate to LOS rate
     rng = np.random.default_rng(cfg["seed"])
     results, panels, tables = {}, [], []
     for band in cfg["bands"]:
@@ -91,7 +94,7 @@ def run(cfg: dict, out, log=print) -> dict:
         rows_b = rows.copy()
         rows_b["value"] = ev.value + b["bias_mps"] + rng.normal(size=len(rows)) * b["sigma_mps"]
         rows_b["sigma"] = b["sigma_mps"]
-        res = _fit(cfg, meas, rows_b, times, x0, t0, t1, b, log)
+        res = _fit(cfg, meas, rows_b, times, to_los, x0, t0, t1, log)
         results[band] = res
         grid = res["grid"]
         half = grid >= t0 + 0.5 * (t1 - t0)
@@ -130,7 +133,7 @@ def run(cfg: dict, out, log=print) -> dict:
     return {"table": table}
 
 
-def _fit(cfg, meas, rows, times, x0, t0, t1, b, log):
+def _fit(cfg, meas, rows, times, to_los, x0, t0, t1, log):
     f = cfg["filter"]
     reg = ParameterRegistry()
     for sc in NAMES:
@@ -139,17 +142,22 @@ def _fit(cfg, meas, rows, times, x0, t0, t1, b, log):
         reg.add_stochastic_acceleration(sc, f["snc_sigma_mps2"], 0.0, cfg["interval_s"])
     reg.add("bias.sst_doppler", "bias", 0.0, f["bias_sigma_los_mps"], owner="L1", observable="sst_doppler")
     opts = FitOptions(max_iter=f["max_iter"], block=cfg["interval_s"])
-    grid, _ = build_grid(reg, t0, t1, opts.block)
-    prob = TrackingProblem(reg, rows, times, force_models(cfg, meas.ephemeris, "filter"), meas, t0, t1,
-                           lookback=2 * cfg["count_time_s"] + 60.0, epochs=grid)
-    _, to_los, status = prob.reference(reg.apriori)
-    if (status != "").any():
-        raise RuntimeError(f"rows the models cannot compute: {set(status[status != ''])}")
-    sig = rows["sigma"].to_numpy(float)
-    obs = Observations(times, rows["value"].to_numpy(float), sig, np.zeros(times.size, int))
-    sol = fit(prob, obs, t0, t1, opts)
+    fm = force_models(cfg, meas.ephemeris, "filter")
+    x_ref = None
+    for days in list(f["stage_days"]) + [None]:     # relinearize on growing arcs (a priori unchanged)
+        end = t1 if days is None else min(t1, t0 + days * DAY)
+        sel = times <= end
+        grid, _ = build_grid(reg, t0, end, opts.block)
+        prob = TrackingProblem(reg, rows[sel].reset_index(drop=True), times[sel], fm, meas, t0, end,
+                               lookback=2 * cfg["count_time_s"] + 60.0, epochs=grid)
+        obs = Observations(times[sel], rows["value"].to_numpy(float)[sel], rows["sigma"].to_numpy(float)[sel],
+                           np.zeros(int(sel.sum()), int))
+        sol = fit(prob, obs, t0, end, opts, x_ref=x_ref)
+        x_ref = sol.smoothed_x[0]
+        log(f"  arc to {(end - t0) / DAY:.1f} d: {len(sol.history)} iterations, post-fit RMS "
+            f"{sol.history[-1]['postfit_rms']:.3f} (whitened), converged {sol.converged}")
     ib = reg.index("bias.sst_doppler")
     post = sol.residuals["postfit"].to_numpy()
     return {"grid": sol.grid, "filtered": sol.filtered_x, "filtered_P": sol.filtered_P,
-            "bias": float(sol.smoothed_x[0, ib] / to_los[0]), "bias_sigma": float(np.sqrt(sol.smoothed_P[0, ib, ib]) / to_los[0]),
+            "bias": float(sol.smoothed_x[0, ib] / to_los), "bias_sigma": float(np.sqrt(sol.smoothed_P[0, ib, ib]) / to_los),
             "postfit_rms": float(np.sqrt(np.nanmean(post**2))), "converged": sol.converged}
