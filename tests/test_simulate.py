@@ -132,7 +132,7 @@ def test_same_seed_same_bytes(sim, tmp_path):
 
     paths, _, _ = sim
     again, _, _ = run_case(CASE, tmp_path, days=DAYS)
-    for role in ("trk234", "utdf:BGS", "utdf:USHS", "tro", "ion", "maneuvers", "maneuvers_executed", "spk", "table", "ramps"):
+    for role in ("trk234", "utdf:BGS", "utdf:USHS", "tdm", "tro", "ion", "maneuvers", "maneuvers_executed", "spk", "table", "ramps"):
         assert hashlib.sha256(paths[role].read_bytes()).digest() == hashlib.sha256(again[role].read_bytes()).digest(), role
     # the OEM writer stamps its CREATION_DATE: everything else is identical
     lines = [[ln for ln in p["oem"].read_text().splitlines() if not ln.startswith("CREATION_DATE")] for p in (paths, again)]
@@ -235,3 +235,25 @@ def test_passes_follow_the_cadence_rules(sim):
                 assert length == net.pass_s, (net.station, length)
         per_day = rows.groupby(rows["epoch"].dt.floor("D"))["pass_id"].nunique()
         assert (per_day <= net.passes).all()
+
+
+def test_tdm_reads_back(sim):
+    from parsers import tdm
+
+    paths, _, obs = sim
+    d = tdm.read(paths["tdm"])
+    got = d.table.sort_values("record", kind="stable").reset_index(drop=True)        # file order
+    order = obs.table.sort_values(["station_rx", "observable"], kind="stable").index   # one segment each
+    want = obs.table.loc[order].reset_index(drop=True)
+    assert len(got) == len(obs.table)
+    assert np.array_equal(got["epoch"].to_numpy(), want["epoch"].to_numpy())
+    assert (got["station_rx"] == want["station_rx"]).all() and (got["station_tx"] == want["station_rx"]).all()
+    rng = (want["observable"] == "range").to_numpy()
+    np.testing.assert_array_equal(got["value"][rng], want["value"][rng])                      # RU and s, exact
+    los = obs.errors["to_los"].to_numpy()[order]
+    np.testing.assert_allclose(got["value"][~rng], want["value"][~rng] * los[~rng], rtol=1e-15)   # m/s
+    assert (got["observable"][~rng] == "range_rate").all()
+    assert (got.loc[~rng, "count_time"].to_numpy() == want.loc[~rng, "count_time"].to_numpy()).all()
+    assert (got.loc[~rng, "tag"] == "interval_end").all()
+    ru = rng & (want["unit"] == "RU").to_numpy()
+    assert (got["range_modulus"][ru] == 2.0**24).all()

@@ -6,6 +6,9 @@ Encodings (what the project's readers decode back):
   format 6 (Doppler counts): per pass a record at the first count start (count 0) and one per
   interval end, ``dop_cnt`` = cumulative cycles of (``dop_cnt_bias_freq`` + Doppler), so
   Doppler (Hz) = diff(count) / count_time - bias; format 9: the uplink ramps.
+* CCSDS TDM (KVN): one segment per station and observable, path 1,2,1; RANGE in RU (modulus
+  in the metadata) or s, two-way Doppler as DOPPLER_INTEGRATED = Doppler (Hz) times the
+  models' m/s per Hz at the row (``to_los``), count interval and END reference.
 * UTDF: destruct Doppler (validity bit 6) count = round((240 MHz - 1000 Doppler) * interval) (shift
   positive approaching),
   range as round-trip delay in 1/256 ns; pad ids from the case, spacecraft id as SIC.
@@ -23,8 +26,10 @@ from odpipe.products.ephemeris import EphemerisSegment
 from odpipe.products.oem import write_oem
 from odpipe.products.spk import write_spk
 from odpipe.time import utc_to_doy
-from parsers import trk234, utdf
+from parsers import tdm, trk234, utdf
 from parsers.maneuvers import PLAN_COLUMNS, write_plan
+from parsers.table import TrackingData
+from parsers.tdm.message import Segment
 from parsers.trk234 import layout
 
 DOPPLER_BIAS_HZ = 1.0e6
@@ -105,6 +110,30 @@ def utdf_records(table: pd.DataFrame, pad: int, sc: int) -> pd.DataFrame:
     }, index=pd.RangeIndex(n, name="record"))[utdf.RECORD_FIELDS]
 
 
+def tdm_data(table: pd.DataFrame, to_los: np.ndarray, created: np.datetime64) -> TrackingData:
+    """A TrackingData that parsers.tdm.write renders as a TDM of the range and two-way Doppler rows."""
+    templates, parts = [], []
+    for (station, obs), g in table.groupby(["station_rx", "observable"], sort=True):
+        meta = {"TIME_SYSTEM": "UTC", "PARTICIPANT_1": station, "PARTICIPANT_2": str(g["spacecraft"].iloc[0]),
+                "MODE": "SEQUENTIAL", "PATH": "1,2,1", "TIMETAG_REF": "RECEIVE", "TRANSMIT_BAND": g["band_up"].iloc[0],
+                "RECEIVE_BAND": g["band_down"].iloc[0], "TURNAROUND_NUMERATOR": "240", "TURNAROUND_DENOMINATOR": "221"}
+        if obs == "range":
+            unit = g["unit"].iloc[0]
+            meta["RANGE_UNITS"] = unit
+            if unit == "RU":
+                meta["RANGE_MODULUS"] = repr(float(g["range_modulus"].iloc[0]))
+            keyword, value = "RANGE", g["value"].to_numpy()
+        else:
+            meta.update(INTEGRATION_INTERVAL=repr(float(g["count_time"].iloc[0])), INTEGRATION_REF="END")
+            keyword, value = "DOPPLER_INTEGRATED", g["value"].to_numpy() * to_los[g.index]
+        parts.append(pd.DataFrame({"segment": len(templates), "keyword": keyword, "value": value,
+                                   "epoch": g["epoch"].to_numpy(), "record": g.index.to_numpy()}))
+        templates.append(Segment(meta=meta))
+    rows = pd.concat(parts, ignore_index=True)
+    header = {"CREATION_DATE": str(created.astype("datetime64[s]")), "ORIGINATOR": "odpipe-simulate"}
+    return TrackingData(rows, meta={"header": header, "segments": templates})
+
+
 def maneuver_plan(maneuvers, dv=None) -> pd.DataFrame:
     """Maneuvers (designed, or ``dv`` (K,3) instead) in the parsers.maneuvers plan schema (ICRF, impulsive)."""
     rows = [{"name": m["name"], "epoch": m["epoch"], "kind": "impulsive", "frame": "ICRF",
@@ -138,6 +167,8 @@ def write_case(out: Path, case, truth, obs, calibrations: dict, setup, stations_
             if len(rows):
                 paths[f"utdf:{net.station}"] = out / f"{case.name}_{net.station}.utdf"
                 utdf.write(paths[f"utdf:{net.station}"], utdf_records(rows, net.pad, sc))
+    paths["tdm"] = out / f"{case.name}.tdm"
+    tdm.write(paths["tdm"], tdm_data(t, obs.errors["to_los"].to_numpy(), case.start))
     paths["table"] = out / "tracking.parquet"
     t.to_parquet(paths["table"])
     paths["ramps"] = out / "ramps.parquet"
