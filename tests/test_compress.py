@@ -267,11 +267,28 @@ def test_running_doppler_counts_become_exact_doppler_in_hz():
     epoch = np.datetime64("2010-11-20T04:38:00", "ns") + (t_s * 1e9).astype("timedelta64[ns]")
     tab = build(n, epoch=epoch, tag="interval_end", observable="doppler_count_2way", value=cycles(t_s), unit="cycles",
                 count_time=np.r_[0.0, np.full(n - 1, dt)], station_tx="DSS-24", station_rx="DSS-24",
-                spacecraft="2", band_up="S", band_down="S", pass_id=0, record=np.arange(n), doppler_bias_hz=bias)
+                spacecraft="2", band_up="S", band_down="S", pass_id=0, record=np.arange(n), doppler_bias_hz=bias,
+                media_m=np.r_[0.0, np.diff(0.5 * t_s**0.5)])    # delay change over each count interval
     out, _ = compress(tab, 60.0)
     dop = out[out["observable"] == "doppler_2way"]
     assert len(dop) == 10 and (dop["unit"] == "Hz").all() and (dop["count_time"] == 60.0).all()
     start = (dop["epoch"].to_numpy() - epoch[0]) / np.timedelta64(1, "s") - 30.0   # tags are interval middles
     exact = (cycles(start + 60.0) - cycles(start)) / 60.0 - bias
     np.testing.assert_allclose(dop["value"], exact, atol=1e-6)
+    np.testing.assert_allclose(dop["media_m"], 0.5 * (start + 60.0) ** 0.5 - 0.5 * start**0.5, rtol=1e-12)
     assert abs(exact[0] - doppler(start[0] + 30.0)) < 20.0  # the mean is near the mid-interval Doppler
+
+
+def test_media_changes_of_doppler_rows_add_up_over_the_window():
+    # six 10-s counts, each with the change of the delay over its own interval: the 60-s row's change is their sum
+    n = 12
+    epoch = np.datetime64("2010-11-21T01:14:10", "ns") + np.arange(n) * np.timedelta64(10, "s")
+    delay = lambda t: 5.0 + 0.01 * t + 1e-5 * t**2          # m, a delay growing through the pass
+    t_end = 10.0 * np.arange(1, n + 1)
+    change = delay(t_end) - delay(t_end - 10.0)
+    tab = build(n, epoch=epoch, tag="interval_end", observable="doppler_2way", value=100.0, unit="Hz",
+                count_time=10.0, station_tx="PAD-11", station_rx="PAD-11", pass_id=0, record=np.arange(n),
+                media_m=change, elevation_rx=np.linspace(0.2, 0.3, n))
+    out, _ = compress(tab, 60.0)
+    np.testing.assert_allclose(out["media_m"], [delay(60.0) - delay(0.0), delay(120.0) - delay(60.0)], rtol=1e-12)
+    assert out["elevation_rx"].iloc[0] == pytest.approx(np.mean(np.linspace(0.2, 0.3, n)[:6]))  # angles average

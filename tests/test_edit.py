@@ -211,3 +211,12 @@ def test_blunders_never_mix_observables_sharing_a_pass_id():
                       station_tx="DSS-14", pass_id=0)
     tab = pd.concat([dop, rng], ignore_index=True)
     assert not blunders(tab).any()
+
+
+def test_rows_without_a_usable_value_are_invalid():
+    n = 4
+    t = np.datetime64("2010-11-21T01:14", "ns") + np.arange(n) * np.timedelta64(10, "s")
+    tab = table.build(n, epoch=t, observable="doppler_2way", value=[np.nan, 1.0, 2.0, 3.0],
+                      count_time=[np.nan, 10.0, 10.0, np.nan], station_rx="PAD-11")
+    from odpipe.preprocess.edit import invalid
+    assert invalid(tab).tolist() == [True, False, False, True]

@@ -95,6 +95,7 @@ stations = ["../case/stations.csv"]
 observables = ["doppler_2way", "range"]
 [calibration]
 tro = ["../case/{Path(files['tro']).name}"]
+ion = ["../case/{Path(files['ion']).name}"]
 [dynamics]
 center = "earth"
 ephemeris = "de421"
@@ -129,7 +130,7 @@ def run_demo(out: Path = Path("out/demo"), workers: int = 2, progress=print) -> 
     case = load_case(CASE)
     case_dir = out / "case"
     stem = case.name
-    files = {"trk234": case_dir / f"{stem}.tnf", "tro": case_dir / f"{stem}.TRO",
+    files = {"trk234": case_dir / f"{stem}.tnf", "tro": case_dir / f"{stem}.TRO", "ion": case_dir / f"{stem}.ION",
              "maneuvers": case_dir / "maneuvers_designed.csv", "spk": case_dir / f"{stem}_truth.bsp",
              "executed": case_dir / "maneuvers_executed_truth.csv"}
     files.update({f"utdf:{n.station}": case_dir / f"{stem}_{n.station}.utdf" for n in case.networks

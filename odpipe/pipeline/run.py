@@ -82,7 +82,6 @@ def _run(cfg: RunConfig, attempt, log: RunLog) -> dict:
     for line in data.log:
         log(line)
     table = data.table[data.table["spacecraft"].astype(str) == cfg.arc.spacecraft].reset_index(drop=True)
-    table = table[table["observable"].isin(cfg.data.observables)].reset_index(drop=True)
     log(f"ingest: {len(table)} rows of spacecraft {cfg.arc.spacecraft} "
         f"({', '.join(f'{k} {v}' for k, v in table['observable'].value_counts().items())})")
 
@@ -109,6 +108,8 @@ def _run(cfg: RunConfig, attempt, log: RunLog) -> dict:
     n_raw = len(table)
     table, creport = compress(table, pre.count_time, ramps=data.ramps, partial=pre.partial, ramp_delay=rtlt)
     log(f"compress: {n_raw} rows -> {len(table)} at {pre.count_time:g} s count time")
+    table = table[table["observable"].isin(cfg.data.observables)].reset_index(drop=True)  # after: counts -> Hz
+    log(f"observables fitted: {', '.join(f'{k} {v}' for k, v in table['observable'].value_counts().items())}")
     edit_cfg = EditConfig(min_elevation=np.radians(pre.elevation_mask_deg), blunder_k=pre.blunder_k,
                           min_pass_samples=pre.min_pass_samples,
                           arc=(np.datetime64(cfg.arc.start, "ns"), np.datetime64(cfg.arc.end, "ns")))

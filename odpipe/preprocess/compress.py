@@ -106,11 +106,28 @@ def _group_records(records: np.ndarray, group: np.ndarray, n_groups: int) -> lis
     return np.split(records, cuts) if n_groups else []
 
 
+# Media columns of a Doppler row are changes of the delay over its count interval (odpipe.media.apply):
+# over a window they add up; of accumulated phase, the window's change is the difference of its ends.
+INTERVAL_CHANGES = ("tropo_m", "iono_m", "media_m", "media_ru")
+
+
+def _window_changes(sub: pd.DataFrame, a: np.ndarray, b: np.ndarray, per_interval: bool) -> dict:
+    """Media columns of windows [a, b] of rows: sums over rows a+1..b (per-interval changes, running
+    counts) or x[b] - x[a] (delays at samples, accumulated phase)."""
+    out = {}
+    for col in INTERVAL_CHANGES:
+        if col in sub:
+            x = np.nan_to_num(sub[col].to_numpy(dtype=float))
+            out[col] = (np.cumsum(x)[b] - np.cumsum(x)[a]) if per_interval else x[b] - x[a]
+    return out
+
+
 def _extra_columns(sub: pd.DataFrame, group: np.ndarray, first: np.ndarray, weights: np.ndarray,
                    n_groups: int) -> dict:
     """Format-specific columns of the compressed rows.
 
-    Floats (e.g. media corrections, elevation) become count-time-weighted means;
+    Media changes (:data:`INTERVAL_CHANGES`) add up over the window; other
+    floats (e.g. elevation) become count-time-weighted means;
     integer codes are kept where constant over the window and set to -1 where
     not (raw parts of the observable, counters); other columns keep the first value.
     """
@@ -119,7 +136,9 @@ def _extra_columns(sub: pd.DataFrame, group: np.ndarray, first: np.ndarray, weig
         if col in COLUMNS or col in NEW_COLUMNS:
             continue
         kind = sub[col].dtype.kind
-        if kind == "f":
+        if col in INTERVAL_CHANGES:
+            out[col] = np.bincount(group, weights=np.nan_to_num(sub[col].to_numpy(dtype=float)), minlength=n_groups)
+        elif kind == "f":
             x = sub[col].to_numpy(dtype=float)
             out[col] = np.bincount(group, weights=x * weights, minlength=n_groups) / np.bincount(
                 group, weights=weights, minlength=n_groups)
@@ -168,7 +187,7 @@ def _compress_averaged(df, ramps, count_ns, tol_ns, delay_ns):
     return out
 
 
-def _compress_phase(df, ramps, count_ns, tol_ns, delay_ns):
+def _compress_phase(df, ramps, count_ns, tol_ns, delay_ns, per_interval: bool = False):
     t = df["epoch"].to_numpy().astype("datetime64[ns]").view(np.int64)
     order, seg = _segments(df, t, t, ramps, tol_ns, contiguous=False, delay_ns=delay_ns)
     sub = df.iloc[order].reset_index(drop=True)
@@ -209,6 +228,8 @@ def _compress_phase(df, ramps, count_ns, tol_ns, delay_ns):
     out["n_samples"] = b - a + 1
     out["source_records"] = [records[i:j + 1] for i, j in zip(a, b)]
     out["scatter"] = scatter * np.sqrt(2.0) / span_s
+    for col, x in _window_changes(sub, a, b, per_interval).items():
+        out[col] = x
     covered = (win >= 0) & (np.arange(len(sub)) <= np.append(b, -1)[win])
     unused = sub.loc[~covered, ["source", "record"]].assign(reason="phase sample without a partner")
     return out, unused
@@ -256,7 +277,7 @@ def compress(table: pd.DataFrame, count_time: float = 60.0, *, ramps: pd.DataFra
         dropped.append(unused)
         report.phase_rows = len(rows)
     if cnt.any():  # differenced like phase: mean biased Doppler over each window, less the bias
-        rows, unused = _compress_phase(table[cnt], ramps, count_ns, tol_ns, delay_ns)
+        rows, unused = _compress_phase(table[cnt], ramps, count_ns, tol_ns, delay_ns, per_interval=True)
         rows["observable"] = rows["observable"].str.replace("doppler_count_", "doppler_", regex=False) \
             .str.removesuffix("_rate")
         rows["value"] = rows["value"] - rows["doppler_bias_hz"].to_numpy(float)

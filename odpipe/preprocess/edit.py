@@ -60,13 +60,17 @@ def duplicates(table: pd.DataFrame) -> np.ndarray:
 
 
 def invalid(table: pd.DataFrame) -> np.ndarray:
-    """Rows the format marks invalid.
+    """Rows the format marks invalid, and rows with no usable value.
 
     A row's own ``valid`` flag decides where it is given (UTDF: the row's
     validity bit; its ``validity`` byte is a bit field, not a verdict);
-    elsewhere ``validity`` != 0 (ODF: 0 good, 1 bad).
+    elsewhere ``validity`` != 0 (ODF: 0 good, 1 bad). A row whose value is
+    not finite (e.g. the first UTDF count of a series), or a Doppler row
+    without a count time, is invalid too.
     """
-    bad = np.zeros(len(table), dtype=bool)
+    value = table["value"].to_numpy(dtype=float)
+    doppler = table["observable"].astype(str).str.startswith("doppler").to_numpy()
+    bad = ~np.isfinite(value) | (doppler & ~np.isfinite(table["count_time"].to_numpy(dtype=float)))
     given = np.zeros(len(table), dtype=bool)
     if "valid" in table:
         v = table["valid"]
