@@ -276,7 +276,7 @@ def _store(out: Evaluation, idx, n, comp: Computed, roles, g, setup):
     for role, (kind, name, obj) in roles.items():
         if kind == "station":
             _put(out, f"station:{name}", ["x", "y", "z"], idx, n, station_partials(comp, role, obj))
-        elif (name, role) not in done and hasattr(obj, "stm"):  # a trajectory without STM gives values only
+        elif (name, role) not in done and getattr(obj, "with_stm", hasattr(obj, "stm")):  # no STM: values only
             done.add((name, role))
             _put(out, f"state:{name}", ["x", "y", "z", "vx", "vy", "vz"], idx, n, epoch_state_partials(comp, role, obj))
             if getattr(obj, "param_names", None):

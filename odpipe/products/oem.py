@@ -36,9 +36,11 @@ def epoch_strings(t_tdb, time_system: str = "TDB") -> list[str]:
 
 def format_oem(segments: list[EphemerisSegment], object_name: str, object_id: str, *,
                time_system: str = "TDB", originator: str = "odpipe", interpolation_degree: int = 7,
-               comments: list[str] = ()) -> str:
-    """The text of an OEM with one data block (and covariance block) per segment."""
-    created = datetime.now(timezone.utc).strftime("%Y-%m-%dT%H:%M:%S")
+               comments: list[str] = (), creation_date: str | None = None) -> str:
+    """The text of an OEM with one data block (and covariance block) per segment.
+
+    ``creation_date`` (ISO, UTC) defaults to now; give one for byte-reproducible files."""
+    created = creation_date or datetime.now(timezone.utc).strftime("%Y-%m-%dT%H:%M:%S")
     out = ["CCSDS_OEM_VERS = 2.0", f"CREATION_DATE = {created}", f"ORIGINATOR = {originator}", ""]
     for seg in segments:
         epochs = epoch_strings(seg.t_tdb, time_system)
