@@ -16,8 +16,10 @@ import pytest
 from odpipe.od.apriori import determine_orbit, doppler_rows
 
 
-@pytest.mark.realdata
-def test_grail_b_orbit_from_doppler_matches_the_mapping_orbit(shared_data):
+MOON_ROTATION_DEG_PER_DAY = 360.0 / 27.321661  # sidereal month (IAU WGCCRE: W-dot = 13.17635815 deg/day)
+
+
+def _orbit(shared_data, odf_name: str, station: str, hours: float):
     from odpipe.dynamics import forces as F
     from odpipe.environment.ephemeris import Ephemeris
     from odpipe.environment.gravity import read_gravity
@@ -28,19 +30,28 @@ def test_grail_b_orbit_from_doppler_matches_the_mapping_orbit(shared_data):
     from parsers import odf
     from parsers.ramps import RampStore
 
-    data = odf.read(shared_data / "grail" / "grblugf2012_100_0434smmmv1.odf")
+    data = odf.read(shared_data / "grail" / odf_name)
     rows = doppler_rows(data.table, data.ramps, "181")
-    # three DSS-24 passes (2012-04-09 06:38-11:29 UTC), about 2.5 orbits
-    rows = rows[(rows["station_rx"] == "DSS-24")]
-    rows = rows[rows["epoch"] < rows["epoch"].min() + pd.Timedelta(hours=5.5)].reset_index(drop=True)
-    assert len(rows) > 150  # 188 windows of 30-60 s
+    rows = rows[(rows["station_rx"] == station)]
+    rows = rows[rows["epoch"] < rows["epoch"].min() + pd.Timedelta(hours=hours)].reset_index(drop=True)
     eph = Ephemeris.open("de421")
     setup = MeasurementSetup(eph, StationCatalog.default(), ramps=RampStore(data.ramps), gcrs_to_itrs=gcrs_to_itrs)
     field = read_gravity(shared_data / "gravity" / "orekit" / "GrazLGM300c.truncated")
     model = F.ForceModel("moon", [F.PointMasses(["earth", "sun"]), F.SphericalHarmonics("moon", field, 12)],
                          ephemeris=eph, central_gm=field.gm)
-    result = determine_orbit(rows, setup, model, "181", moon_pa_to_icrf, 1737.4e3)
+    return rows, determine_orbit(rows, setup, model, "181", moon_pa_to_icrf, 1737.4e3)
 
+
+@pytest.fixture(scope="module")
+def april_9(shared_data):
+    """Three DSS-24 passes (2012-04-09 06:38-11:29 UTC), about 2.5 orbits."""
+    return _orbit(shared_data, "grblugf2012_100_0434smmmv1.odf", "DSS-24", 5.5)
+
+
+@pytest.mark.realdata
+def test_grail_b_orbit_from_doppler_matches_the_mapping_orbit(april_9):
+    rows, result = april_9
+    assert len(rows) > 150  # 188 windows of 30-60 s
     el = result.elements
     assert 20e3 < el["altitude"] < 100e3  # 54.7 km
     assert 110 * 60 < el["period"] < 116 * 60  # 113.5 min
@@ -59,3 +70,16 @@ def test_grail_b_orbit_from_doppler_matches_the_mapping_orbit(shared_data):
     # the epoch is the start of the data (2012-04-09 06:38 UTC = 387225569 TDB s past J2000)
     from odpipe.time import utc_to_tdb
     assert 0.0 < float(utc_to_tdb(rows["epoch"].min().to_datetime64())) - result.epoch < 60.0
+
+
+@pytest.mark.realdata
+def test_grail_b_node_two_days_later_has_turned_with_the_moon(shared_data, april_9):
+    """A polar orbit's node stays fixed in inertial space (J2 precession ~ cos i ~ 0), so its
+    longitude in the Moon's body frame falls by the Moon's rotation: the orbits found
+    independently on 04-09 (DSS-24) and 04-11 (DSS-24, file 102) must differ by that much."""
+    day1 = april_9[1]
+    _, day3 = _orbit(shared_data, "grblugf2012_102_0055smmmv1.odf", "DSS-24", 4.5)
+    days = (day3.epoch - day1.epoch) / 86400.0  # 2.07
+    turned = np.degrees(day3.elements["raan"] - day1.elements["raan"])
+    assert turned == pytest.approx(-MOON_ROTATION_DEG_PER_DAY * days, abs=1.5)  # -27.8 vs -27.3 deg
+    assert day3.rms_los < 0.3  # 0.12 m/s
