@@ -47,13 +47,9 @@ def _iso(t_tdb: float) -> str:
     return str((utc + np.timedelta64(500, "ms")).astype("datetime64[s]"))
 
 
-SK_THRESHOLD = 5e-3  # m/s: station-keeping burns are larger; attitude (spin-axis) burns are ~1 mm/s
-
-
-def arcs(start: float, end: float, plan: pd.DataFrame) -> list[tuple[str, str, float, float]]:
-    """(name, 'short'|'long', start, end TDB s) of the arcs around the station-keeping maneuvers of ``plan``."""
-    dv = np.linalg.norm(plan[["dv1", "dv2", "dv3"]].to_numpy(float), axis=1)
-    sk = sorted(float(utc_to_tdb(np.datetime64(e, "ns"))) for e in plan["epoch"][dv > SK_THRESHOLD])
+def arcs(start: float, end: float, sk: list[float]) -> list[tuple[str, str, float, float]]:
+    """(name, 'short'|'long', start, end TDB s) of the arcs around the station-keeping epochs ``sk`` (TDB s)."""
+    sk = sorted(sk)
     out = []
     for k, (a, b) in enumerate(zip(sk[:-1], sk[1:])):  # short arcs: both ends of each maneuver interval
         span = min(5 * 86400.0, (b - a) - 2 * HOUR)
@@ -66,12 +62,17 @@ def arcs(start: float, end: float, plan: pd.DataFrame) -> list[tuple[str, str, f
     return out
 
 
+SPIN_DOPPLER = 2e-4  # m/s: the spin signature left in 60-s Doppler (~3 mHz at S-band), not modelled
+
+
 def _sigma_keys(case) -> dict:
-    """Per-station data sigmas at the fitted 60-s count time (LOS m, m/s)."""
+    """Per-station data sigmas at the fitted 60-s count time (LOS m, m/s), as an analyst sets them from the
+    pre-fit scatter: the noise and the unmodelled spin signature together."""
     sig = {"doppler_2way": 1e-4, "range": 2.0}
     for net in case.networks:
         name = f"PAD-{net.pad}" if net.format == "utdf" else net.station
-        sig[f"doppler_2way:{name}"] = net.sigma_doppler * np.sqrt(min(net.doppler_count_s, 60.0) / 60.0)
+        noise = net.sigma_doppler * np.sqrt(min(net.doppler_count_s, 60.0) / 60.0)
+        sig[f"doppler_2way:{name}"] = float(np.hypot(noise, SPIN_DOPPLER))
         if net.range_step_s:
             sig[f"range:{name}"] = net.sigma_range
     return sig
@@ -142,8 +143,8 @@ def run_demo(out: Path = Path("out/demo"), workers: int = 2, progress=print) -> 
     sigmas = _sigma_keys(case)
     arc_dir = out / "arcs"
     arc_dir.mkdir(parents=True, exist_ok=True)
-    from parsers.maneuvers import read_plan
-    plan = arcs(float(utc_to_tdb(case.start)), float(utc_to_tdb(case.end)), read_plan(files["maneuvers"]))
+    plan = arcs(float(utc_to_tdb(case.start)), float(utc_to_tdb(case.end)),
+                list(np.asarray(utc_to_tdb(case.station_keeping_epochs()), float)))
     configs = []
     for name, _, a, b in plan:
         path = arc_dir / f"{name}.toml"
@@ -188,7 +189,9 @@ def _report(out: Path, case, plan, files, truth) -> dict:
         z = []
         for seg in oem.read(cur / "trajectory.oem"):
             tc = (seg.cov_epochs - np.datetime64("2000-01-01T12:00:00", "ns")) / np.timedelta64(1, "s")
-            inside = (tc > a + HOUR) & (tc < b - HOUR)
+            ends = (seg.epochs[[0, -1]] - np.datetime64("2000-01-01T12:00:00", "ns")) / np.timedelta64(1, "s")
+            # away from the arc ends, and from maneuver epochs (pre- and post-burn states meet there)
+            inside = (tc > a + HOUR) & (tc < b - HOUR) & (tc > ends[0] + 1.0) & (tc < ends[1] - 1.0)
             if inside.any():
                 e = traj[n].state(tc[inside]) - truth.state(tc[inside])
                 z.append(e / np.sqrt(np.einsum("kii->ki", seg.covariances[inside])))
