@@ -71,13 +71,15 @@ def apriori(cfg_path: Path, data_root: Path):
 
 
 def fit(cfg_path: Path):
-    from odpipe.od.arc import fit_arc
+    """Run the arc through ``odpipe run`` (ingest .. fit_arc .. products); print its summary and time."""
     from odpipe.pipeline.run import run_config
 
     clock = time.perf_counter()
-    out = run_config(cfg_path, progress=None)
-    print(f"fit of {cfg_path.name}: {time.perf_counter() - clock:.0f} s, {out}")
-    return fit_arc
+    out = run_config(cfg_path, force=True, progress=None)
+    print(f"fit of {cfg_path.name}: {time.perf_counter() - clock:.0f} s")
+    for key, value in out.items():
+        print(f"  {key}: {value}")
+    return out
 
 
 def main():
