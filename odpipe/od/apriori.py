@@ -42,14 +42,12 @@ from scipy.optimize import least_squares
 from odpipe.dynamics.forces import ForceModel
 from odpipe.dynamics.propagator import propagate
 from odpipe.measurements import MeasurementSetup, compute, residuals
+from odpipe.measurements.bands import C_LIGHT
 from odpipe.preprocess.compress import compress
 from odpipe.preprocess.edit import EditConfig, edit
 from odpipe.preprocess.flags import Flag, set_flag
 from odpipe.preprocess.timetags import interval_bounds
 from odpipe.time import utc_to_tdb
-
-
-C_LIGHT = 299_792_458.0
 
 
 @dataclass
@@ -123,14 +121,12 @@ class LineOfSight:
         d = self.p0 + self.p1
         return d / np.linalg.norm(d, axis=1)[:, None]
 
-    def model(self, r0, r1, phi0=None, phi1=None):
-        """Modelled y (N,) for positions r0, r1 (N,3) at t0, t1; with the STMs (N,6,6) also d y / d x0."""
+    def model(self, r0, r1, phi0, phi1):
+        """Modelled y (N,) for positions r0, r1 (N,3) at t0, t1, and d y / d x0 (N,6) from the STMs (N,6,6)."""
         d0, d1 = self.p0 + r0, self.p1 + r1
         n0, n1 = np.linalg.norm(d0, axis=1), np.linalg.norm(d1, axis=1)
         dt = self.t1 - self.t0
         y = (n1 - n0 - np.linalg.norm(self.p1, axis=1) + np.linalg.norm(self.p0, axis=1)) / dt
-        if phi0 is None:
-            return y
         jac = (np.einsum("ni,nij->nj", d1 / n1[:, None], phi1[:, :3, :])
                - np.einsum("ni,nij->nj", d0 / n0[:, None], phi0[:, :3, :])) / dt[:, None]
         return y, jac
