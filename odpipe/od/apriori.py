@@ -337,7 +337,7 @@ def determine_orbit(rows: pd.DataFrame, setup: MeasurementSetup, force_model: Fo
 
 def _postfit(rows, setup, force_model, spacecraft, x, start, end):
     """Residuals of every row (m/s along the line of sight, and Hz) for epoch state x."""
-    ev = compute(rows, {spacecraft: propagate(x, start, end, force_model)}, setup)  # compute() needs the STM
+    ev = compute(rows, {spacecraft: propagate(x, start, end, force_model, with_stm=False)}, setup)
     hz, los = residuals(rows, ev)
     return los, hz
 
