@@ -69,7 +69,8 @@ class Trajectory:
     def sensitivity(self, t) -> np.ndarray:
         if not self.with_stm:
             raise ValueError("trajectory propagated without the variational equations")
-        return self._values(t)[:, 42:].reshape(-1, 6, len(self.param_names))
+        v = self._values(t)
+        return v[:, 42:].reshape(len(v), 6, len(self.param_names))
 
 
 class TrajectorySet(dict):
