@@ -48,7 +48,9 @@ def test_all_dsn_antennas_follow_the_naif_station_spk(shared_data):
             if st.dss is None:
                 continue
             spice = np.array([sp.spkpos(st.name, x, "ITRF93", "NONE", "EARTH")[0] for x in t]) * 1e3
-            assert np.abs(st.position_itrs(t) - spice).max() < 1e-6, st.name  # measured 1e-9 m
+            # Rev M antennas measured 1e-9 m; DSS-27 carries Goldstone's rounded plate rate: 0.6 mm by 2020
+            tol = 1e-3 if st.name == "DSS-27" else 1e-6
+            assert np.abs(st.position_itrs(t) - spice).max() < tol, st.name
     finally:
         sp.unload(spk)  # only ours: other modules may hold kernels in the same session
         sp.unload(old)
