@@ -34,3 +34,18 @@ def test_table_4_4_figures_by_hand():
     # sigma of the estimated magnitude: along the estimated direction, from per-axis sigmas
     u = np.array([0.303, 0.396, 0.001]) / e1
     assert rows.loc[0, "estimated sigma (mm/s)"] == pytest.approx(1.0 * np.linalg.norm(u), rel=1e-12)
+
+
+def test_maneuvers_command_reads_run_products(tmp_path, capsys):
+    from odpipe.cli import main
+
+    flat = flatten(pd.DataFrame({
+        "maneuver": ["SK1"], "designed": [np.array([0.3, 0.4, 0.0])],
+        "estimated": [np.array([0.303, 0.396, 0.0])], "sigma": [np.array([1e-3, 1e-3, 1e-3])]}))
+    run = tmp_path / "run"
+    run.mkdir()
+    flat.to_csv(run / "maneuvers.csv", index=False)
+    assert main(["maneuvers", str(run), "-o", str(tmp_path / "out")]) == 0
+    stats = pd.read_csv(tmp_path / "out" / "maneuver_summary.csv", index_col=0)
+    assert stats.loc["Max", "X (mm/s)"] == pytest.approx(3.0, rel=1e-9)
+    assert "Average" in capsys.readouterr().out
