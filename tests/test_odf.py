@@ -17,6 +17,7 @@ import pytest
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
+from tests.fuzzing import mutated
 from parsers import ParseError, odf
 
 MESSENGER = "messenger/odf07155.odf"
@@ -237,15 +238,7 @@ def odf_head(shared_data):
 @settings(max_examples=150, deadline=None, suppress_health_check=[HealthCheck.function_scoped_fixture])
 @given(data=st.data())
 def test_fuzz_only_parse_errors(odf_head, tmp_path_factory, data):
-    buf = bytearray(odf_head)
-    kind = data.draw(st.sampled_from(["flip", "cut", "random"]))
-    if kind == "flip":
-        for pos in data.draw(st.lists(st.integers(0, len(buf) - 1), min_size=1, max_size=20)):
-            buf[pos] ^= 1 << data.draw(st.integers(0, 7))
-    elif kind == "cut":
-        buf = buf[: data.draw(st.integers(0, len(buf)))]
-    else:
-        buf = bytearray(data.draw(st.binary(max_size=2000)))
+    buf = mutated(data, odf_head)
     p = tmp_path_factory.mktemp("fuzz") / "f.odf"
     p.write_bytes(bytes(buf))
     for mode in ("raise", "report"):

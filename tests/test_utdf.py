@@ -19,6 +19,7 @@ import pytest
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
+from tests.fuzzing import mutated
 from parsers import ParseError, utdf
 
 C_KM_S = 299792.458
@@ -184,15 +185,7 @@ def utdf_head(shared_data):
 @settings(max_examples=150, deadline=None, suppress_health_check=[HealthCheck.function_scoped_fixture])
 @given(data=st.data())
 def test_fuzz_only_parse_errors(utdf_head, tmp_path_factory, data):
-    buf = bytearray(utdf_head)
-    kind = data.draw(st.sampled_from(["flip", "cut", "random"]))
-    if kind == "flip":
-        for pos in data.draw(st.lists(st.integers(0, len(buf) - 1), min_size=1, max_size=20)):
-            buf[pos] ^= 1 << data.draw(st.integers(0, 7))
-    elif kind == "cut":
-        buf = buf[: data.draw(st.integers(0, len(buf)))]
-    else:
-        buf = bytearray(data.draw(st.binary(max_size=2000)))
+    buf = mutated(data, utdf_head)
     p = tmp_path_factory.mktemp("fuzz") / "f.utdf"
     p.write_bytes(bytes(buf))
     for mode in ("raise", "report"):
