@@ -35,7 +35,7 @@ def monte_carlo(trial: Callable[[np.random.Generator, int], Any], n_runs: int, s
     from dask.distributed import Client, LocalCluster
 
     with LocalCluster(n_workers=n_workers, threads_per_worker=1, processes=True,
-                      dashboard_address=None) as cluster, Client(cluster) as client:
+                      dashboard_address=":0") as cluster, Client(cluster) as client:
         futures = client.map(_one, [trial] * n_runs, rngs, range(n_runs), pure=False)
         return client.gather(futures)
 
