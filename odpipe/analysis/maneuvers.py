@@ -53,7 +53,7 @@ def evaluate(table: pd.DataFrame) -> tuple[pd.DataFrame, pd.DataFrame]:
         figures += [np.abs(d[:, i] - e[:, i]), np.abs(d[:, i] - e[:, i]) / _nonzero(np.abs(d[:, i]))]
     for name, values in zip(COLUMNS, figures):
         rows[name] = values * (1e3 if "mm/s" in name else 100.0)
-    stats = pd.DataFrame({name: [np.nanmean(rows[name]), np.nanmedian(rows[name]), np.nanmax(rows[name]),
-                                 np.nanmin(rows[name])] for name in COLUMNS},
+    stats = pd.DataFrame({name: [rows[name].mean(), rows[name].median(), rows[name].max(), rows[name].min()]
+                          for name in COLUMNS},  # NaN skipped; all-NaN columns stay NaN
                          index=["Average", "Median", "Max", "Min"])
     return rows, stats
