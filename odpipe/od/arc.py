@@ -83,6 +83,7 @@ class ArcSetup:
     reweight: bool = False
     block: float = 600.0
     lookback: float = 120.0
+    growing_days: float | None = 2.0  # first span of the growing-arc start (None: fit the whole arc at once)
     tabulate_earth_rotation: bool = True
 
 
@@ -203,8 +204,27 @@ def fit_arc(table: pd.DataFrame, setup: ArcSetup) -> ArcSolution:
     sig = data_sigma(used, setup.data_sigma) / to_los[good]
     group = (used["observable"] + ":" + used["station_rx"].astype(str)).to_numpy(object)
     obs = Observations(times[good], used["value"].to_numpy(float), sig, group)
-    sol = fit(problem, obs, setup.start, setup.end, options)
+    x_ref = None
+    for end in growing_ends(setup):  # unstable orbits: reach the full arc through shorter ones
+        x_ref = fit(problem, obs, setup.start, end, replace(options, edit_k=(np.inf,)), x_ref=x_ref).x0
+    sol = fit(problem, obs, setup.start, setup.end, options, x_ref=x_ref)
     return _solution(setup, reg, problem, sol, rows, times, to_los, status)
+
+
+def growing_ends(setup: ArcSetup) -> list[float]:
+    """Ends (TDB s) of the shorter arcs fitted first: ``growing_days``, doubling, below the arc's end.
+
+    Over a long arc of an unstable orbit (libration orbits) an a priori a kilometre off is far outside the
+    linear regime at the arc's end; each fit starts from the previous one's smoothed epoch estimate and
+    the original a priori, so nothing is counted twice.
+    """
+    if not setup.growing_days:
+        return []
+    ends, d = [], setup.growing_days
+    while setup.start + d * 86400.0 < setup.end - 0.5 * d * 86400.0:
+        ends.append(setup.start + d * 86400.0)
+        d *= 2.0
+    return ends
 
 
 def _solution(setup, reg, problem, sol, rows, times, to_los, status) -> ArcSolution:
