@@ -1,0 +1,20 @@
+"""The growing-arc start of long arcs: which shorter arcs are fitted first."""
+
+from types import SimpleNamespace
+
+import pytest
+
+from odpipe.od.arc import growing_ends
+
+DAY = 86400.0
+
+
+@pytest.mark.parametrize("days, growing, expected", [
+    (14.0, 2.0, [2.0, 4.0, 8.0]),     # the demo's long arcs: 2, 4, 8 days, then all 14
+    (5.0, 2.0, [2.0]),                 # a short arc: one 2-day start
+    (2.5, 2.0, []),                    # no shorter arc when it would be nearly the whole arc
+    (14.0, None, []),                  # switched off
+])
+def test_growing_arc_ends(days, growing, expected):
+    setup = SimpleNamespace(start=1000.0, end=1000.0 + days * DAY, growing_days=growing)
+    assert [(e - 1000.0) / DAY for e in growing_ends(setup)] == expected
