@@ -38,12 +38,22 @@ def trajectory_from_oem(path) -> PiecewiseTrajectory:
     return PiecewiseTrajectory(pieces)
 
 
+def _labels(paths) -> list[str]:
+    """File stems, or the run's name when the stems repeat (run products are all ``trajectory.oem``)."""
+    stems = [p.stem for p in paths]
+    if len(set(stems)) == len(stems):
+        return stems
+    return [p.resolve().parent.parent.name if p.resolve().parent.name == "current" else p.resolve().parent.name
+            for p in paths]
+
+
 def run(args) -> int:
     if len(args.oem) < 2:
         raise SystemExit("odpipe overlap needs at least two OEM files")
     trajs = [trajectory_from_oem(p) for p in args.oem]
-    overlaps = [compare(a, b, f"{pa.stem} - {pb.stem}", args.step)
-                for (a, pa), (b, pb) in zip(zip(trajs, args.oem), zip(trajs[1:], args.oem[1:]))]
+    names = _labels(args.oem)
+    overlaps = [compare(a, b, f"{na} - {nb}", args.step)
+                for (a, na), (b, nb) in zip(zip(trajs, names), zip(trajs[1:], names[1:]))]
     table = summarize(overlaps)
     args.out.mkdir(parents=True, exist_ok=True)
     write_text(args.out / "overlaps.csv", table.to_csv(index=False))
