@@ -43,7 +43,7 @@ def _labels(paths) -> list[str]:
     stems = [p.stem for p in paths]
     if len(set(stems)) == len(stems):
         return stems
-    return [p.resolve().parent.parent.name if p.resolve().parent.name == "current" else p.resolve().parent.name
+    return [p.absolute().parent.parent.name if p.absolute().parent.name == "current" else p.absolute().parent.name
             for p in paths]
 
 
