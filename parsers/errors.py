@@ -51,11 +51,16 @@ class ParseReport:
         return iter(self.errors)
 
 
+def check_mode(errors: str) -> None:
+    """Refuse an ``errors`` argument other than "raise" or "report" before any reading starts."""
+    if errors not in ("raise", "report"):
+        raise ValueError(f"errors must be 'raise' or 'report', not {errors!r}")
+
+
 def handle(err: ParseError, errors: str, report: ParseReport | None) -> None:
     """Raise ``err`` (errors="raise") or record it in ``report`` (errors="report")."""
+    check_mode(errors)
     if errors == "raise":
         raise err
-    if errors != "report":
-        raise ValueError(f"errors must be 'raise' or 'report', not {errors!r}")
     if report is not None:
         report.add(err)

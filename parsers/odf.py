@@ -44,7 +44,7 @@ import numpy as np
 import pandas as pd
 
 from parsers import table as tt
-from parsers.errors import ParseError, ParseReport, handle
+from parsers.errors import ParseError, ParseReport, check_mode, handle
 from parsers.table import TrackingData
 
 RECORD = 36
@@ -130,8 +130,7 @@ def transponder_ratio(band_up: np.ndarray, band_down: np.ndarray) -> np.ndarray:
 
 def read(path, errors: str = "raise") -> TrackingData:
     """Read an ODF into a TrackingData (orbit data table, ramp table, report, header facts)."""
-    if errors not in ("raise", "report"):
-        raise ValueError(f"errors must be 'raise' or 'report', not {errors!r}")
+    check_mode(errors)
     path = Path(path)
     buf = path.read_bytes()
     report = ParseReport()

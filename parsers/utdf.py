@@ -44,7 +44,7 @@ import numpy as np
 import pandas as pd
 
 from parsers import table as tt
-from parsers.errors import ParseError, ParseReport, handle
+from parsers.errors import ParseError, ParseReport, check_mode, handle
 from parsers.odf import code_labels, time_ordered
 from parsers.table import TrackingData
 
@@ -85,8 +85,7 @@ def sniff(head: bytes) -> bool:
 
 def read(path, errors: str = "raise") -> TrackingData:
     """Read a UTDF file into a TrackingData; ``meta["records"]`` keeps every field of every record."""
-    if errors not in ("raise", "report"):
-        raise ValueError(f"errors must be 'raise' or 'report', not {errors!r}")
+    check_mode(errors)
     path = Path(path)
     buf = path.read_bytes()
     report = ParseReport()

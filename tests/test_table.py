@@ -25,3 +25,13 @@ def test_parse_error_survives_pickling():
     err = ParseError("x.odf", "bad data type 99", offset=2016, record=7)
     for back in (pickle.loads(pickle.dumps(err)), copy.deepcopy(err)):
         assert str(back) == str(err) and back.offset == 2016 and back.record == 7
+
+
+def test_readers_refuse_an_unknown_errors_mode_before_reading(tmp_path):
+    import pytest
+    from parsers import odf, utdf
+
+    missing = tmp_path / "not_read.bin"  # never opened: the mode is checked first
+    for reader in (odf, utdf):
+        with pytest.raises(ValueError, match="errors must be 'raise' or 'report'"):
+            reader.read(missing, errors="skip")
