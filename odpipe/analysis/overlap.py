@@ -16,6 +16,10 @@ import pandas as pd
 from scipy.interpolate import CubicHermiteSpline
 
 from odpipe.frames.local import rtn_matrix
+from odpipe.time import utc_to_tdb
+from parsers import oem
+
+_J2000 = np.datetime64("2000-01-01T12:00:00", "ns")
 
 COMPONENTS = ("radial", "intrack", "crosstrack")
 
@@ -58,6 +62,21 @@ class PiecewiseTrajectory:
         for j in np.unique(k):
             out[k == j] = self.pieces[j].state(t[k == j])
         return out
+
+
+def oem_trajectory(path) -> PiecewiseTrajectory:
+    """All segments of an OEM as one trajectory in TDB seconds past J2000 (m, m/s)."""
+    pieces = []
+    for seg in oem.read(path):
+        scale = seg.meta.get("TIME_SYSTEM", "UTC")
+        if scale == "TDB":
+            t = (seg.epochs - _J2000) / np.timedelta64(1, "s")
+        elif scale == "UTC":
+            t = utc_to_tdb(seg.epochs)
+        else:
+            raise ValueError(f"{path}: TIME_SYSTEM {scale} not supported (TDB or UTC)")
+        pieces.append(SampledTrajectory(t, seg.states))
+    return PiecewiseTrajectory(pieces)
 
 
 @dataclass

@@ -25,8 +25,7 @@ import numpy as np
 import pandas as pd
 
 from odpipe.analysis import maneuvers as maneuver_report
-from odpipe.analysis.overlap import compare, plot_overlaps, summarize
-from odpipe.commands.overlap import trajectory_from_oem
+from odpipe.analysis.overlap import compare, oem_trajectory, plot_overlaps, summarize
 from odpipe.pipeline.run import run_config
 from odpipe.products.atomic import write_text
 from odpipe.products.spk import SpkTrajectory
@@ -35,6 +34,8 @@ from odpipe.runs.report import Section, write_report
 from odpipe.simulate.case import load as load_case
 from odpipe.simulate.run import run_case
 from odpipe.time import tdb_to_utc, utc_to_tdb
+from parsers import oem
+from parsers.maneuvers import read_plan
 
 CASE = Path(__file__).resolve().parents[2] / "runs" / "artemis_p2_like.toml"
 HOUR = 3600.0
@@ -161,7 +162,7 @@ def run_demo(out: Path = Path("out/demo"), workers: int = 2, progress=print) -> 
 def _report(out: Path, case, plan, files, truth) -> dict:
     runs = out / "runs"
     done = [(n, k, a, b) for n, k, a, b in plan if (runs / n / "current" / "trajectory.oem").exists()]
-    traj = {n: trajectory_from_oem(runs / n / "current" / "trajectory.oem") for n, *_ in done}
+    traj = {n: oem_trajectory(runs / n / "current" / "trajectory.oem") for n, *_ in done}
     sections, headline = [], {"case": case.name, "arcs fitted": f"{len(done)} of {len(plan)}"}
     for kind in ("short", "long"):
         names = [n for n, k, *_ in done if k == kind]
@@ -185,7 +186,6 @@ def _report(out: Path, case, plan, files, truth) -> dict:
         t = np.arange(a, b, 1800.0)
         err = traj[n].state(t) - truth.state(t)
         summary = json.loads((cur / "summary.json").read_text())
-        from parsers import oem
         z = []
         for seg in oem.read(cur / "trajectory.oem"):
             tc = (seg.cov_epochs - np.datetime64("2000-01-01T12:00:00", "ns")) / np.timedelta64(1, "s")
@@ -222,7 +222,6 @@ def _report(out: Path, case, plan, files, truth) -> dict:
 
 
 def _maneuvers(out: Path, done, files):
-    from parsers.maneuvers import read_plan
     rows = []
     for n, kind, *_ in done:
         path = out / "runs" / n / "current" / "maneuvers.csv"
