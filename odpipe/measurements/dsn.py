@@ -18,7 +18,10 @@ Conventions, all tested:
   with f_R the receiver's reference: the same ramp as f_T by default, the
   receiver's own ramp, or a constant f_REF (ODF ramped data are referenced to
   the record's reference frequency: their values are M2 f_REF - f_received,
-  checked on MESSENGER and Cassini ODFs where M2 (f_REF - f_T) is ~1 MHz).
+  checked on MESSENGER and Cassini ODFs where M2 (f_REF - f_T) is ~1 MHz; tudat's
+  model of the same records is Moyer eq. 13-54, ``M2 f_REF - (M2/Tc) integral(f_T dt1)``).
+  Data transmitted while the uplink is being acquired (retune, sweep) do not follow
+  the ramp table and are edited (:mod:`odpipe.preprocess.uplink`).
   It is **positive when the spacecraft recedes** (the received
   frequency falls below M2 f). For a constant uplink it reduces to
   ``F = M2 f (rho_e - rho_s) / Tc``. Evaluated as

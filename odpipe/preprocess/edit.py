@@ -10,6 +10,8 @@ Editors look only at columns, so they run on any TrackingTable:
   test on the signal detrended against each sample's neighbours
   (:func:`odpipe.preprocess.robust.spikes`);
 * range ambiguity: range outside [0, modulus) (``range_modulus_ru`` or ``range_modulus``);
+* uplink acquisitions: two/three-way rows transmitted while the uplink was being
+  retuned and swept into lock (:mod:`odpipe.preprocess.uplink`; needs ``rtlt_s``);
 * short passes, outside the arc, analyst windows;
 * residual outliers during a fit (:func:`residual_outliers`, called by the filter).
 """
@@ -23,7 +25,9 @@ import pandas as pd
 
 from odpipe.preprocess.flags import Flag, set_flag, summary
 from odpipe.preprocess.passes import LINK, assign_passes, link_id
+from odpipe.preprocess.ramp_segments import store
 from odpipe.preprocess.robust import gross, outliers, spikes
+from odpipe.preprocess.uplink import in_acquisition
 
 
 @dataclass
@@ -38,6 +42,8 @@ class EditConfig:
     arc: tuple | None = None        # (start, end) UTC
     windows: list = field(default_factory=list)  # analyst windows: dicts start, end[, station_rx, observable]
     max_gap: float = 600.0          # s, pass break
+    sweep_rate: float = 10.0        # Hz/s, |ramp rate| of an acquisition sweep
+    acquisition_lead: float = 3600.0  # s, longest retune-to-sweep time of one acquisition
 
 
 MODULUS_COLUMNS = ("range_modulus_ru", "range_modulus")
@@ -154,7 +160,8 @@ def residual_outliers(table: pd.DataFrame, residual: np.ndarray, k: float = 5.0,
 def edit(table: pd.DataFrame, ramps: pd.DataFrame | None = None, config: EditConfig | None = None):
     """Flag ``table`` with every editor; returns (new table, summary of rows per reason).
 
-    ``ramps`` serve the pass segmentation when ``pass_id`` is unset.
+    ``ramps`` (table or RampStore) serve the pass segmentation when ``pass_id`` is unset
+    and the uplink-acquisition editor.
     """
     config = config or EditConfig()
     out = assign_passes(table, ramps, max_gap=config.max_gap) if (table["pass_id"] < 0).any() else table.copy()
@@ -163,7 +170,9 @@ def edit(table: pd.DataFrame, ramps: pd.DataFrame | None = None, config: EditCon
     flags = set_flag(flags, duplicates(out), Flag.DUPLICATE)
     flags = set_flag(flags, below_elevation(out, config.min_elevation), Flag.ELEVATION)
     flags = set_flag(flags, range_outside_modulus(out), Flag.AMBIGUITY)
-    untested = (flags & int(Flag.INVALID | Flag.DUPLICATE | Flag.AMBIGUITY)) != 0
+    flags = set_flag(flags, in_acquisition(out, store(ramps), config.sweep_rate, config.acquisition_lead),
+                     Flag.UPLINK)
+    untested = (flags & int(Flag.INVALID | Flag.DUPLICATE | Flag.AMBIGUITY | Flag.UPLINK)) != 0
     flags = set_flag(flags, blunders(out, config, use=~untested), Flag.BLUNDER)
     flags = set_flag(flags, short_passes(out, config.min_pass_samples, config.min_pass_duration), Flag.SHORT_PASS)
     if config.arc is not None:

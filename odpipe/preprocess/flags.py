@@ -24,6 +24,7 @@ class Flag(enum.IntFlag):
     OUTSIDE_ARC = 1 << 7     # outside the fit arc
     RESIDUAL = 1 << 8        # residual outlier during the fit
     PARTIAL_COUNT = 1 << 9   # compressed sample shorter than the target count time
+    UPLINK = 1 << 10         # transmitted during an uplink acquisition (retune, sweep): not on the ramp table
 
 
 def names(value: int) -> list[str]:
