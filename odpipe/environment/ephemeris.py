@@ -332,3 +332,65 @@ def interp_states(coeffs, t_start, t_step, t):
             out[b, c] = p
             out[b, 3 + c] = v * dsdt
     return out
+
+
+class SpanEphemeris:
+    """An :class:`Ephemeris` front serving ``state``/``position`` over one TDB span from Chebyshev pieces.
+
+    Measurement evaluation asks for the same few body pairs (Earth and the
+    spacecraft's centre about the SSB, the Shapiro bodies) at every light-time
+    iteration; jplephem's per-call overhead then dominates. Epochs inside
+    [t0, t1] (TDB s) are served by :meth:`Ephemeris.interpolant` pieces (one per
+    body pair, built on first use, numba-evaluated; they reproduce the file to
+    < 2 mm and 1e-6 m/s), anything else by the file itself. Every other
+    attribute (``gm``, ``interpolant``, ...) is the wrapped ephemeris's.
+    """
+
+    def __init__(self, ephemeris: Ephemeris, t0: float, t1: float):
+        self.ephemeris, self.t0, self.t1 = ephemeris, float(t0), float(t1)
+        self._pieces: dict[tuple[int, int], EphemerisInterpolant] = {}
+
+    def __getattr__(self, name):
+        return getattr(self.ephemeris, name)
+
+    def _served(self, target, center, t: np.ndarray) -> EphemerisInterpolant | None:
+        key = (body_id(target), body_id(center))
+        if not t.size or key[0] == key[1] or t.min() < self.t0 or t.max() > self.t1:
+            return None
+        if key not in self._pieces:
+            self._pieces[key] = self.ephemeris.interpolant([key[0]], key[1], self.t0, self.t1)
+        return self._pieces[key]
+
+    def state(self, target, center, t_tdb) -> np.ndarray:
+        """State (m, m/s) as :meth:`Ephemeris.state`."""
+        t = np.asarray(t_tdb, dtype=float)
+        ip = self._served(target, center, t)
+        if ip is None:
+            return self.ephemeris.state(target, center, t)
+        return interp_states_many(ip.coeffs, ip.t_start, ip.t_step, t.ravel())[:, 0].reshape(t.shape + (6,))
+
+    def position(self, target, center, t_tdb) -> np.ndarray:
+        """Position (m) as :meth:`Ephemeris.position`."""
+        t = np.asarray(t_tdb, dtype=float)
+        ip = self._served(target, center, t)
+        if ip is None:
+            return self.ephemeris.position(target, center, t)
+        return interp_positions_many(ip.coeffs, ip.t_start, ip.t_step, t.ravel())[:, 0].reshape(t.shape + (3,))
+
+
+@njit(cache=True)
+def interp_states_many(coeffs, t_start, t_step, t):
+    """(N, nbody, 6) m, m/s at the TDB epochs ``t`` (N,)."""
+    out = np.empty((t.size, coeffs.shape[0], 6))
+    for i in range(t.size):
+        out[i] = interp_states(coeffs, t_start, t_step, t[i])
+    return out
+
+
+@njit(cache=True)
+def interp_positions_many(coeffs, t_start, t_step, t):
+    """(N, nbody, 3) m at the TDB epochs ``t`` (N,)."""
+    out = np.empty((t.size, coeffs.shape[0], 3))
+    for i in range(t.size):
+        out[i] = interp_positions(coeffs, t_start, t_step, t[i])
+    return out

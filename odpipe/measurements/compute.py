@@ -43,12 +43,14 @@ Rows that cannot be computed get NaN and a reason in :attr:`Evaluation.status`.
 
 from __future__ import annotations
 
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from typing import Callable, Mapping
 
 import numpy as np
 import pandas as pd
 
+from odpipe.environment.ephemeris import SpanEphemeris
+from odpipe.frames.tabulated import TabulatedRotation
 from odpipe.preprocess.timetags import interval_bounds
 
 from . import angles, crosslink, dsn, instantaneous
@@ -117,6 +119,7 @@ def compute(rows: pd.DataFrame, trajectories: Mapping, setup: MeasurementSetup) 
     n = len(rows)
     out = Evaluation(np.full(n, np.nan), np.full(n, np.nan), np.full(n, "", dtype=object), {}, {})
     df = rows.reset_index(drop=True)
+    setup = _spanning(setup, df["epoch"])
     sc2 = df["spacecraft_2"] if "spacecraft_2" in df.columns else pd.Series([""] * n)
     keys = [df["observable"], df["unit"], df["station_tx"], df["station_rx"], df["spacecraft"].astype(str),
             sc2.astype(str), df["tag"]]
@@ -129,6 +132,28 @@ def compute(rows: pd.DataFrame, trajectories: Mapping, setup: MeasurementSetup) 
             continue
         _store(out, idx, n, comp, roles, g, setup)
     return out
+
+
+SPAN_MARGIN_S = 86400.0  # s around the rows' epochs: light times (hours) and count intervals
+
+
+def spanning(setup: MeasurementSetup, t0: float, t1: float) -> MeasurementSetup:
+    """``setup`` tabulated over [t0, t1] TDB s: ephemeris from Chebyshev pieces (:class:`SpanEphemeris`),
+    Earth orientation from a Chebyshev table (:class:`TabulatedRotation`). Parts already tabulated are kept."""
+    eph, rot = setup.ephemeris, setup.gcrs_to_itrs
+    if hasattr(eph, "interpolant") and not isinstance(eph, SpanEphemeris):
+        eph = SpanEphemeris(eph, t0, t1)
+    if rot is not None and not isinstance(rot, TabulatedRotation):
+        rot = TabulatedRotation(rot, t0, t1)
+    return replace(setup, ephemeris=eph, gcrs_to_itrs=rot)
+
+
+def _spanning(setup: MeasurementSetup, epoch: pd.Series) -> MeasurementSetup:
+    """``setup`` tabulated over the rows' epochs with :data:`SPAN_MARGIN_S` either side."""
+    if not len(epoch):
+        return setup
+    t, _ = anchor_from_utc(np.array([epoch.min(), epoch.max()], dtype="datetime64[ns]"))
+    return spanning(setup, t[0] - SPAN_MARGIN_S, t[1] + SPAN_MARGIN_S)
 
 
 def _evaluate(key, g, trajectories, setup):

@@ -25,12 +25,12 @@ from odpipe.estimation.fit import EDIT_INNOVATION, FitOptions, Observations, Sol
 from odpipe.estimation.maneuvers import maneuver_table
 from odpipe.estimation.registry import GaussMarkov, ParameterRegistry
 from odpipe.measurements import MeasurementSetup
+from odpipe.measurements.compute import spanning
 from odpipe.preprocess.flags import Flag
 from odpipe.preprocess.timetags import interval_bounds
 from odpipe.time import utc_to_tdb
 
 from .problem import TrackingProblem
-from .rotation import TabulatedRotation
 
 
 @dataclass(frozen=True)
@@ -189,7 +189,7 @@ def fit_arc(table: pd.DataFrame, setup: ArcSetup) -> ArcSolution:
     meas = setup.measurements
     if setup.tabulate_earth_rotation and meas.gcrs_to_itrs is not None:
         span = (setup.start - setup.lookback - 3600.0, setup.end + 3600.0)
-        meas = replace(meas, gcrs_to_itrs=TabulatedRotation(meas.gcrs_to_itrs, *span))
+        meas = spanning(meas, *span)
 
     def problem_for(r, t):
         return TrackingProblem(reg, r, t, {setup.spacecraft: setup.force_model}, meas,

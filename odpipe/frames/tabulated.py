@@ -1,4 +1,4 @@
-"""Earth orientation tabulated once per arc: a Chebyshev table of the GCRS->ITRS matrix.
+"""Earth orientation tabulated once per span (an arc, a batch of rows): a Chebyshev table of the GCRS->ITRS matrix.
 
 The measurement models ask for the full IAU 2006/2000A rotation with EOP at every
 light-time event of every row (several times per row and iteration); over an arc

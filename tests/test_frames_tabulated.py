@@ -6,7 +6,7 @@ import numpy as np
 import pytest
 
 from odpipe.frames.earth import gcrs_to_itrs
-from odpipe.od.rotation import TabulatedRotation
+from odpipe.frames.tabulated import TabulatedRotation
 from odpipe.time import utc_to_tdb
 
 
