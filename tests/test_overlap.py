@@ -3,8 +3,8 @@
 import numpy as np
 import pytest
 
-from odpipe.analysis.overlap import (SampledTrajectory, compare, long_arc_schedule, plot_overlaps,
-                                     short_arc_schedule, summarize)
+from odpipe.analysis.overlap import (PiecewiseTrajectory, SampledTrajectory, compare, long_arc_schedule,
+                                     plot_overlaps, short_arc_schedule, summarize)
 from odpipe.frames.local import rtn_matrix
 
 GM = 3.986004418e14
@@ -125,3 +125,24 @@ def test_piecewise_trajectory_switches_at_the_maneuver():
     assert (traj.t0, traj.t1) == (0.0, 7200.0)
     assert traj.state(3600.0)[0, 3] == pytest.approx(circular(np.array([3600.0]))[0, 3] + 0.01)
     assert traj.state(3599.0)[0, 3] == pytest.approx(circular(np.array([3599.0]))[0, 3], abs=1e-9)
+
+
+def test_oem_trajectory_keeps_its_centre_for_the_measurement_models(tmp_path):
+    """An OEM about the Moon read back is a Moon-centred trajectory (the measurement models add the Moon's
+    barycentric state); without the centre a GRAIL product was evaluated as if about the SSB."""
+    from odpipe.analysis.overlap import oem_trajectory
+    from odpipe.measurements.nodes import SpacecraftNode
+    from odpipe.products.ephemeris import EphemerisSegment
+    from odpipe.products.oem import write_oem
+    from odpipe.environment.ephemeris import Ephemeris
+
+    t = np.arange(3.87e8, 3.87e8 + 7201.0, 60.0)
+    x = circular(t - t[0]) * 0.3
+    path = write_oem(tmp_path / "moon.oem", [EphemerisSegment(t, x, "moon")], "SC", "1", time_system="TDB")
+    traj = oem_trajectory(path)
+    assert traj.center == "moon"
+    eph = Ephemeris.open("de421")
+    node = SpacecraftNode(traj, eph, "ssb")
+    np.testing.assert_allclose(node.state(t[:3]), x[:3] + eph.state("moon", "ssb", t[:3]), rtol=0, atol=1e-6)
+    with pytest.raises(ValueError, match="different centres"):
+        PiecewiseTrajectory([SampledTrajectory(t, x, "moon"), SampledTrajectory(t + 7200.0, x, "earth")])

@@ -29,10 +29,12 @@ class SampledTrajectory:
 
     ``t_tdb`` (N,) s, ``states`` (N,6) m, m/s. Between nodes h apart the
     position error is of order h⁴·|r⁗|/384: keep h small against the orbit's
-    time scales (60 s is ample for lunar and libration orbits).
+    time scales (60 s is ample for lunar and libration orbits). ``center``: the
+    body the states are relative to (e.g. 'moon'), as the measurement models read it.
     """
 
-    def __init__(self, t_tdb, states):
+    def __init__(self, t_tdb, states, center: str | None = None):
+        self.center = center
         self.t_tdb = np.asarray(t_tdb, dtype=float)
         states = np.asarray(states, dtype=float)
         self._spline = CubicHermiteSpline(self.t_tdb, states[:, :3], states[:, 3:], axis=0)
@@ -52,6 +54,10 @@ class PiecewiseTrajectory:
 
     def __init__(self, pieces):
         self.pieces = sorted(pieces, key=lambda p: p.t0)
+        centers = {getattr(p, "center", None) for p in self.pieces}
+        if len(centers) > 1:
+            raise ValueError(f"trajectory pieces relative to different centres: {sorted(map(str, centers))}")
+        self.center = centers.pop()
         self.t0, self.t1 = self.pieces[0].t0, self.pieces[-1].t1
         self._starts = np.array([p.t0 for p in self.pieces])
 
@@ -65,7 +71,7 @@ class PiecewiseTrajectory:
 
 
 def oem_trajectory(path) -> PiecewiseTrajectory:
-    """All segments of an OEM as one trajectory in TDB seconds past J2000 (m, m/s)."""
+    """All segments of an OEM as one trajectory in TDB seconds past J2000 (m, m/s), centred as its CENTER_NAME."""
     pieces = []
     for seg in oem.read(path):
         scale = seg.meta.get("TIME_SYSTEM", "UTC")
@@ -75,7 +81,8 @@ def oem_trajectory(path) -> PiecewiseTrajectory:
             t = utc_to_tdb(seg.epochs)
         else:
             raise ValueError(f"{path}: TIME_SYSTEM {scale} not supported (TDB or UTC)")
-        pieces.append(SampledTrajectory(t, seg.states))
+        center = str(seg.meta.get("CENTER_NAME", "")).strip().lower() or None
+        pieces.append(SampledTrajectory(t, seg.states, center))
     return PiecewiseTrajectory(pieces)
 
 
