@@ -106,7 +106,10 @@ def test_convert_edit_compress_commands(shared_data, tmp_path, capsys):
     assert len(row) == 1 and row["flags"].iloc[0] & int(Flag.BLUNDER)
     assert sum(len(r) for r in t_comp["source_records"]) == len(t_raw)
     assert t_comp["count_time"].max() == 60.0 and "raw records not represented: 0" in out
-    assert main(["convert", str(src), "-o", str(tmp_path / "x.tdm")]) == 2  # no TDM metadata in an ODF
+    # an ODF written as TDM: every Doppler row becomes a RECEIVE_FREQ line, the ramps TRANSMIT_FREQ lines
+    assert main(["convert", str(src), "-o", str(tmp_path / "x.tdm")]) == 0
+    back = formats.read_any(tmp_path / "x.tdm")
+    assert (back.table["observable"] == "receive_freq").sum() == len(t_raw) and len(back.ramps) == len(ramps)
 
 
 @pytest.mark.realdata

@@ -5,6 +5,7 @@ from __future__ import annotations
 from pathlib import Path
 
 from odpipe.preprocess import store
+from odpipe.products.tdm import to_tdm
 from parsers import formats
 from parsers.table import TrackingData
 
@@ -38,9 +39,10 @@ def run(args) -> int:
     elif suffix in TDM_SYNTAX:
         from parsers import tdm
 
-        if "segments" not in data.meta:
-            print("TDM output needs TDM segment metadata: only a file read as TDM can be written as TDM yet")
-            return 2
+        if "segments" not in data.meta:  # not read from a TDM: map the table onto TDM keywords
+            data, skipped = to_tdm(data)
+            if len(skipped):
+                print(f"not written (no TDM keyword, or no value): {skipped['observable'].value_counts().to_dict()}")
         tdm.write(args.output, data, syntax=TDM_SYNTAX[suffix])
         written = [args.output]
     else:
