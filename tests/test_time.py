@@ -112,3 +112,14 @@ def test_odf_and_day_of_year():
     np.testing.assert_array_equal(d, [366, 58])
     with pytest.raises(ValueError, match="day of year"):
         T.doy_to_utc(2012, 367)
+
+
+def test_geocentric_tdb_minus_tt_from_hourly_values_equals_erfa():
+    """The hourly-cached geocentric series, over three years and after a jump to another decade."""
+    from odpipe.time.scales import tdb_minus_tt
+
+    rng = np.random.default_rng(1)
+    for start in (3.0e8, 8.0e8, 3.0e8):
+        t = np.sort(rng.uniform(start, start + 9.5e7, 5000))
+        ref = erfa.dtdb(2451545.0, t / 86400.0, 0.0, 0.0, 0.0, 0.0)
+        assert np.abs(tdb_minus_tt(t) - ref).max() < 1e-14  # s

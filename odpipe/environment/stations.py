@@ -80,7 +80,9 @@ class Station:
         """ITRS position (m) with plate motion at epochs ``t`` (datetime64 UTC or TDB s); epoch position if None."""
         if t is None:
             return self.r_itrs.copy()
-        _, tt_days = utc_and_tt(t)
+        arr = np.asarray(t)
+        # TDB seconds stand for TT here: 2 ms apart, nothing at plate-motion rates (cm/yr)
+        tt_days = arr / 86400.0 if arr.dtype.kind in "fiu" else utc_and_tt(arr)[1]
         years = (np.asarray(tt_days) * 86400.0 - _calendar_year_s(self.epoch_year)) / JULIAN_YEAR_S
         return self.r_itrs + np.asarray(years)[..., None] * self.v_itrs_per_yr
 

@@ -18,7 +18,7 @@ from __future__ import annotations
 import erfa
 import numpy as np
 
-from odpipe.environment.interpolation import on_uniform_grid
+from odpipe.environment.interpolation import lagrange4_uniform
 from odpipe.time.leap_seconds import NS_PER_DAY, NS_PER_S, tai_minus_utc_ns, utc_ns_from_tai_ns
 
 TT_MINUS_TAI_NS = 32_184_000_000
@@ -71,10 +71,44 @@ def _station_terms(station_itrs):
     return np.arctan2(y, x), np.hypot(x, y) / 1e3, z / 1e3
 
 
+class _HourlyGeocentricDtdb:
+    """The geocentric TDB-TT series (ERFA dtdb) at whole TT hours, computed once per hour and kept.
+
+    Its shortest terms are far longer than an hour, so cubic interpolation between the
+    hourly values errs by < 1e-15 s; the light-time loops ask for the same hours many times.
+    """
+
+    PAD_H, MAX_H = 240, 24 * 366 * 5  # hours added around a request; longest span kept
+
+    def __init__(self):
+        self.first, self.values = 0, np.empty(0)
+
+    def __call__(self, tt_days: np.ndarray) -> np.ndarray:
+        hours = np.asarray(tt_days, dtype=float) * 24.0
+        lo, hi = int(np.floor(hours.min())) - 2, int(np.ceil(hours.max())) + 3
+        last = self.first + self.values.size - 1
+        if not self.values.size or lo < self.first or hi > last:
+            lo, hi = lo - self.PAD_H, hi + self.PAD_H
+            if self.values.size and max(hi, last) - min(lo, self.first) <= self.MAX_H:
+                lo, hi = min(lo, self.first), max(hi, last)
+            grid = np.arange(lo, hi + 1, dtype=float)
+            values = erfa.dtdb(J2000_JD, grid / 24.0, 0.0, 0.0, 0.0, 0.0)
+            if hi - lo > self.MAX_H:  # a span of many years: interpolate without keeping it
+                return lagrange4_uniform(float(lo), 1.0, values, hours)
+            self.first, self.values = lo, values
+        return lagrange4_uniform(float(self.first), 1.0, self.values, hours)
+
+
+_geocentric_dtdb = _HourlyGeocentricDtdb()
+
+
 def _dtdb(tt_days_j2000, ut_fraction, station_itrs):
-    """ERFA dtdb; the geocentric series (no diurnal terms) is gridded at 1 h for many epochs (error < 1e-15 s)."""
+    """ERFA dtdb; the geocentric series (no diurnal terms) from hourly values (:class:`_HourlyGeocentricDtdb`)."""
     if station_itrs is None:
-        return on_uniform_grid(lambda d: erfa.dtdb(J2000_JD, d, 0.0, 0.0, 0.0, 0.0), tt_days_j2000, 1.0 / 24.0)
+        t = np.asarray(tt_days_j2000, dtype=float)
+        if t.size < 8:
+            return erfa.dtdb(J2000_JD, t, 0.0, 0.0, 0.0, 0.0)
+        return _geocentric_dtdb(t.ravel()).reshape(t.shape)
     elong, u, v = _station_terms(station_itrs)
     return erfa.dtdb(J2000_JD, tt_days_j2000, ut_fraction, elong, u, v)
 
