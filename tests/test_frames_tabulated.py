@@ -17,4 +17,5 @@ def test_table_matches_the_full_model_over_three_days():
     err = np.abs(tab(t) - gcrs_to_itrs(t)).max()
     assert err < 1e-12                                  # 6 micrometres at the Earth's surface
     with pytest.raises(ValueError, match="outside"):
-        tab(np.array([t0 - 1.0]))
+        tab(np.array([tab.t0 - 1.0]))
+    assert tab.t0 <= t0 and tab.t0 % 3600.0 == 0.0  # segments on whole hours of TDB

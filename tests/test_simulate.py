@@ -212,7 +212,10 @@ def test_models_reproduce_the_utdf_files(sim):
         e = e.set_index(key.to_numpy()).loc[rkey.to_numpy()]
         clean = rows["value"].to_numpy() - (e["media"] + e["noise"] + e["bias"] + e["spin"]).to_numpy()
         is_range = (rows["observable"] == "range").to_numpy()
-        tol = np.where(is_range, 0.5 / 256e9, 5e-5) + 1e-12
+        # Doppler: the encoding's 5e-5 Hz, plus 1.5e-4 Hz (10 um/s over the 10-s count): compute() tabulates
+        # the ephemeris and Earth orientation over the rows it is given, and the simulator's rows and these
+        # differ; barycentric positions then round differently at the 1e-4 m level
+        tol = np.where(is_range, 0.5 / 256e9, 5e-5 + 1.5e-4) + 1e-12
         assert np.all(np.abs(clean - ev.value) <= tol * 1.01), role
 
 

@@ -99,6 +99,36 @@ class _Link:
     record_origin: float  # TDB s past J2000 where the file's Chebyshev records start
 
 
+def _chebyshev_sets(coeffs, jd_start, days_per_set, jd1, jd2, velocity: bool):
+    """Position (km) and velocity (km/day) from equal-length Chebyshev sets starting at ``jd_start``.
+
+    The offset into a set is formed from the whole-day part first, so the time argument keeps
+    ~1e-11 s (jplephem's legacy ``Ephemeris`` adds the fraction to days since 1900, which
+    rounds it to ~0.6 us: millimetres of noise in the Earth's barycentric position).
+    """
+    jd1 = np.asarray(jd1, dtype=float)
+    jd2 = np.asarray(jd2, dtype=float)
+    whole = jd1 - jd_start
+    index = np.floor((whole + jd2) / days_per_set).astype(np.int64)
+    index = np.clip(index, 0, coeffs.shape[0] - 1)
+    offset = (whole - index * days_per_set) + jd2
+    x = 2.0 * offset / days_per_set - 1.0
+    c = coeffs[index]  # (N, 3, ncoef)
+    n = c.shape[-1]
+    T = np.empty((n,) + x.shape)
+    T[0], T[1] = 1.0, x
+    for k in range(2, n):
+        T[k] = 2.0 * x * T[k - 1] - T[k - 2]
+    pos = np.einsum("nak,kn->an", c, T)
+    if not velocity:
+        return pos, None
+    D = np.empty_like(T)
+    D[0], D[1] = 0.0, 1.0
+    for k in range(2, n):
+        D[k] = 2.0 * T[k - 1] + 2.0 * x * D[k - 1] - D[k - 2]
+    return pos, np.einsum("nak,kn->an", c, D) * (2.0 / days_per_set)
+
+
 class Ephemeris:
     """A planetary ephemeris: states of bodies relative to each other in ICRF, SI units."""
 
@@ -154,11 +184,11 @@ class Ephemeris:
         origin = (lo - J2000_JD) * _DAY
 
         def series(name, scale=1.0):
+            coeffs = eph.load(name)  # (sets, 3, ncoef) km, sets of equal length from jalpha
+
             def compute(jd1, jd2, velocity):
-                if not velocity:
-                    return scale * eph.position(name, jd1, jd2), None
-                p, v = eph.position_and_velocity(name, jd1, jd2)
-                return scale * p, scale * v
+                p, v = _chebyshev_sets(coeffs, lo, (hi - lo) / coeffs.shape[0], jd1, jd2, velocity)
+                return scale * p, (scale * v if velocity else None)
             return _Link(0, compute, lo, hi, origin)
 
         links = {i: series(n) for i, n in enumerate(
@@ -205,12 +235,16 @@ class Ephemeris:
     def _relative(self, target, center, t_tdb, velocity: bool):
         t = np.asarray(t_tdb, dtype=float)
         jd1, jd2 = jd_split(t)
+        return self._relative_jd(target, center, jd1, jd2, velocity).reshape(t.shape + (6 if velocity else 3,))
+
+    def _relative_jd(self, target, center, jd1, jd2, velocity: bool):
+        """(N, 3 or 6) m, m/s at two-part TDB Julian dates."""
         a, b = self._chain(body_id(target)), self._chain(body_id(center))
         common = next(x for x in a if x in b)
         pa, va = self._sum_to(a, common, jd1, jd2, velocity)
         pb, vb = self._sum_to(b, common, jd1, jd2, velocity)
         parts = [(pa - pb) * 1e3] + ([(va - vb) * (1e3 / _DAY)] if velocity else [])
-        return np.concatenate(parts).T.reshape(t.shape + (3 * len(parts),))
+        return np.concatenate(parts).T
 
     def state(self, target, center, t_tdb) -> np.ndarray:
         """State (m, m/s) of ``target`` relative to ``center`` in ICRF at TDB s past J2000: (N,6) or (6,)."""
@@ -246,12 +280,18 @@ class Ephemeris:
         npiece = max(1, int(np.ceil((t1 - t0) / piece_s)))
         k = np.arange(ncoef)
         x = np.cos(np.pi * (k + 0.5) / ncoef)  # Chebyshev-Gauss nodes on [-1, 1]
-        t_nodes = t0 + piece_s * (np.arange(npiece)[:, None] + 0.5 * (x[None, :] + 1.0))
+        # node epochs as two-part Julian dates: whole days of the (integral) piece starts plus a
+        # small fraction, so the file is sampled at the nodes themselves (TDB seconds near 3e8 s
+        # round to 6e-8 s: 2 mm of the Earth's barycentric motion)
+        starts = t0 + piece_s * np.arange(npiece)
+        days = np.floor(starts / _DAY)
+        jd1 = np.repeat(J2000_JD + days, ncoef)
+        jd2 = (((starts - days * _DAY)[:, None] + 0.5 * piece_s * (x[None, :] + 1.0)) / _DAY).ravel()
         basis = np.cos(np.pi * np.outer(k, k + 0.5) / ncoef) * (2.0 / ncoef)  # (coef j, node)
         basis[0] *= 0.5
         coeffs = np.empty((len(ids), npiece, 3, ncoef))
         for i, body in enumerate(ids):
-            p = self.position(body, center, t_nodes.ravel()).reshape(npiece, ncoef, 3)
+            p = self._relative_jd(body, center, jd1, jd2, velocity=False).reshape(npiece, ncoef, 3)
             ref = p[:, ncoef // 2, :]  # fit offsets from one node: keeps the DCT sums free of cancellation
             coeffs[i] = np.einsum("jn,pnc->pcj", basis, p - ref[:, None, :])
             coeffs[i, :, :, 0] += ref
@@ -342,7 +382,7 @@ class SpanEphemeris:
     iteration; jplephem's per-call overhead then dominates. Epochs inside
     [t0, t1] (TDB s) are served by :meth:`Ephemeris.interpolant` pieces (one per
     body pair, built on first use, numba-evaluated; they reproduce the file to
-    < 2 mm and 1e-6 m/s), anything else by the file itself. Every other
+    < 0.3 mm and 1e-6 m/s), anything else by the file itself. Every other
     attribute (``gm``, ``interpolant``, ...) is the wrapped ephemeris's.
     """
 

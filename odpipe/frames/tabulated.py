@@ -29,6 +29,8 @@ class TabulatedRotation:
     """``rotation(t) -> (N, 3, 3)`` tabulated over ``[t0, t1]`` (TDB s); outside it, an error."""
 
     def __init__(self, rotation, t0: float, t1: float):
+        # segments on whole multiples of SEGMENT_S: tables of overlapping spans give identical values
+        t0, t1 = np.floor(t0 / SEGMENT_S) * SEGMENT_S, np.ceil(t1 / SEGMENT_S) * SEGMENT_S
         self.t0, self.t1 = float(t0), float(t1)
         coef, meta = fit_channel(lambda t: np.asarray(rotation(t), float).reshape(-1, 9), t0, t1, SEGMENT_S, DEGREE)
         self._coefs, self._meta = coef[None], meta[None]
