@@ -415,7 +415,7 @@ class SpanEphemeris:
         ip = self._served(target, center, t)
         if ip is None:
             return self.ephemeris.position(target, center, t)
-        return interp_positions_many(ip.coeffs, ip.t_start, ip.t_step, t.ravel())[:, 0].reshape(t.shape + (3,))
+        return interp_states_many(ip.coeffs, ip.t_start, ip.t_step, t.ravel())[:, 0, :3].reshape(t.shape + (3,))
 
 
 @njit(cache=True)
@@ -424,13 +424,4 @@ def interp_states_many(coeffs, t_start, t_step, t):
     out = np.empty((t.size, coeffs.shape[0], 6))
     for i in range(t.size):
         out[i] = interp_states(coeffs, t_start, t_step, t[i])
-    return out
-
-
-@njit(cache=True)
-def interp_positions_many(coeffs, t_start, t_step, t):
-    """(N, nbody, 3) m at the TDB epochs ``t`` (N,)."""
-    out = np.empty((t.size, coeffs.shape[0], 3))
-    for i in range(t.size):
-        out[i] = interp_positions(coeffs, t_start, t_step, t[i])
     return out
