@@ -29,6 +29,7 @@ import pandas as pd  # noqa: E402
 
 from odpipe.analysis.overlap import compare, oem_trajectory  # noqa: E402
 from odpipe.pipeline.run import run_config  # noqa: E402
+from odpipe.products import residuals  # noqa: E402
 from odpipe.time import utc_to_tdb  # noqa: E402
 
 HERE = Path(__file__).resolve().parent
@@ -48,18 +49,14 @@ def derived_config(arc: str, degree: int, out: Path) -> Path:
     return path
 
 
-def residual_rms(run: Path) -> pd.DataFrame:
-    """Post-fit RMS of the fitted rows per station and pass: mm/s along the line of sight and mHz."""
-    r = pd.read_parquet(run / "residuals.parquet")
-    r = r[(r["flags"] == 0) & (r["status"] == "")]
-    rms = lambda s: float(np.sqrt(np.mean(np.square(s))))  # noqa: E731
-    g = r.groupby(["station_rx", "pass_id"])
-    per_pass = pd.DataFrame({"n": g.size(), "rms_mm_s": g["postfit_los"].apply(rms) * 1e3,
-                             "rms_mhz": g["postfit"].apply(rms) * 1e3}).reset_index()
-    g = r.groupby("station_rx")
-    per_station = pd.DataFrame({"n": g.size(), "rms_mm_s": g["postfit_los"].apply(rms) * 1e3,
-                                "rms_mhz": g["postfit"].apply(rms) * 1e3}).reset_index()
-    return per_station, per_pass
+def residual_rms(run: Path) -> tuple[pd.DataFrame, pd.DataFrame]:
+    """Post-fit RMS of the fitted rows per station, and per station and pass: mm/s along the line of sight and mHz."""
+    res = pd.read_parquet(run / "residuals.parquet")
+    out = []
+    for by in (("station_rx",), ("station_rx", "pass_id")):
+        st = residuals.statistics(res, by=by)
+        out.append(st.assign(n=st["n_used"], rms_mm_s=st["postfit_rms"] * 1e3, rms_mhz=st["postfit_rms_unit"] * 1e3))
+    return out[0], out[1]
 
 
 def main(argv=None) -> int:

@@ -131,6 +131,8 @@ def _products(cfg, attempt, log, table, arc, edits, fit_seconds) -> dict:
     table.to_parquet(attempt.product("tracking.parquet"))
     res.to_parquet(attempt.product("residuals.parquet"))
     write_text(attempt.product("residual_statistics.csv"), stats.to_csv(index=False))
+    per_pass = residuals.statistics(res, by=("station_rx", "observable", "pass_id"))
+    write_text(attempt.product("residual_statistics_passes.csv"), per_pass.to_csv(index=False))
     params = arc.parameters.copy()
     write_text(attempt.product("parameters.csv"), params.to_csv(index=False))
     man_rows = man_stats = None
@@ -155,7 +157,8 @@ def _products(cfg, attempt, log, table, arc, edits, fit_seconds) -> dict:
             figures.append((png, f"{which} residuals along the line of sight"))
     summary = _summary(cfg, arc, stats, fit_seconds)
     write_text(attempt.product("summary.json"), json.dumps(summary, indent=1, default=float))
-    sections = [Section("Residuals").table(stats), Section("Editing").table(edits)]
+    sections = [Section("Residuals").table(stats), Section("Residuals per pass").table(per_pass),
+                Section("Editing").table(edits)]
     for png, caption in figures:
         sections[0].figure(png, caption)
     sections.append(Section("Estimated parameters").table(params))

@@ -25,17 +25,24 @@ def display_scale(observable: str) -> tuple[float, str]:
     return (1e3, "mm/s") if is_rate(observable) else (1.0, "m")
 
 
+def _rms(x) -> float:
+    return float(np.sqrt(np.mean(np.square(x))))
+
+
 def statistics(res: pd.DataFrame, by=("station_rx", "observable")) -> pd.DataFrame:
-    """Count, used count, mean and RMS of pre- and post-fit residuals (LOS units) per group of used rows."""
+    """Count, used count, mean and RMS of pre- and post-fit residuals (LOS units) per group of used rows,
+    and the post-fit RMS in the observable's own unit (``postfit_rms_unit``, e.g. Hz) when given."""
     ok = res["status"].eq("") if "status" in res else pd.Series(True, index=res.index)
     used = res[ok & res["flags"].eq(0)]
     g = used.groupby(list(by), sort=True)
     out = pd.DataFrame({
         "n_used": g.size(),
         "postfit_mean": g["postfit_los"].mean(),
-        "postfit_rms": g["postfit_los"].apply(lambda x: float(np.sqrt(np.mean(x**2)))),
-        "prefit_rms": g["prefit_los"].apply(lambda x: float(np.sqrt(np.mean(x**2)))),
+        "postfit_rms": g["postfit_los"].apply(_rms),
+        "prefit_rms": g["prefit_los"].apply(_rms),
     })
+    if "postfit" in used.columns:
+        out["postfit_rms_unit"] = g["postfit"].apply(_rms)
     out["n_edited"] = res[ok].groupby(list(by)).size().reindex(out.index).fillna(0).astype(int) - out["n_used"]
     return out.reset_index()
 
