@@ -108,17 +108,22 @@ def test_doppler_converges_to_range_rate_as_count_time_shrinks():
     assert errs[2] < 1e-3  # Hz; second-order in Tc
 
 
-def test_doppler_partials_vs_finite_differences_of_epoch_state():
+@pytest.mark.parametrize("uplink, reference", [(ConstantUplink(F_UP), None), (_ramp(50.0), None),
+                                               (_ramp(50.0), np.full(EPOCHS.size, F_UP + 1e5))],
+                         ids=["constant", "ramped", "ramped-odf-reference"])
+def test_doppler_partials_vs_finite_differences_of_epoch_state(uplink, reference):
+    """Constant and ramped (50 Hz/s) uplinks, with the transmitter's ramp or an ODF f_REF as the reference."""
     traj, st = _scenario()
-    up = ConstantUplink(F_UP)
-    d = _doppler(traj, st, EPOCHS, 60.0, up)
+    up = uplink
+    kw = {} if reference is None else {"reference": reference}
+    d = _doppler(traj, st, EPOCHS, 60.0, up, **kw)
     h = np.array([100.0] * 3 + [0.01] * 3)
     fd = np.zeros((EPOCHS.size, 6))
     for i in range(6):
         dx = np.zeros(6)
         dx[i] = h[i]
-        plus = _doppler(traj.with_epoch_state(traj.x0 + dx), st, EPOCHS, 60.0, up).value
-        minus = _doppler(traj.with_epoch_state(traj.x0 - dx), st, EPOCHS, 60.0, up).value
+        plus = _doppler(traj.with_epoch_state(traj.x0 + dx), st, EPOCHS, 60.0, up, **kw).value
+        minus = _doppler(traj.with_epoch_state(traj.x0 - dx), st, EPOCHS, 60.0, up, **kw).value
         fd[:, i] = (plus - minus) / (2 * h[i])
     an = epoch_state_partials(d, "spacecraft", traj)
     np.testing.assert_allclose(an[:, 3:], fd[:, 3:], rtol=1e-5)
