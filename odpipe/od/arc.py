@@ -35,12 +35,14 @@ from .problem import TrackingProblem
 
 @dataclass(frozen=True)
 class ManeuverPlan:
-    """A logged impulsive maneuver: label, epoch (TDB s), designed ICRF dV (m/s), a priori sigma per axis (m/s)."""
+    """A logged impulsive maneuver: label, epoch (TDB s), designed ICRF dV (m/s), a priori sigma per axis (m/s),
+    a priori sigma (s) of its firing-epoch offset (None: epoch not estimated; Table 4.1: 10 s)."""
 
     label: str
     epoch: float
     designed: tuple = (0.0, 0.0, 0.0)
     sigma: float = 0.01
+    sigma_epoch: float | None = None
 
 
 @dataclass
@@ -149,7 +151,7 @@ def build_registry(setup: ArcSetup, rows: pd.DataFrame) -> ParameterRegistry:
         g = setup.stochastic
         reg.add_stochastic_acceleration(sc, g.sigma, g.tau, g.batch)
     for m in setup.maneuvers:
-        reg.add_maneuver(sc, m.label, m.epoch, m.sigma, m.designed)
+        reg.add_maneuver(sc, m.label, m.epoch, m.sigma, m.designed, sigma_epoch=m.sigma_epoch)
     if setup.range_bias_sigma is not None:
         rng = rows[rows["observable"] == "range"]
         for st, pid in rng[["station_rx", "pass_id"]].drop_duplicates().itertuples(index=False):

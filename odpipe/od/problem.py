@@ -10,6 +10,9 @@ state           epoch position/velocity (``registry.add_state``), relative to th
 dynamic         a force-model parameter: ``info['model']`` in ``srp_scale``, ``rho_s[k]``, ``rho_d[k]``
 stochastic      RTN accelerations (``registry.add_stochastic_acceleration``, axes R, T, N), m/s^2
 maneuver        impulsive ICRF dV (``registry.add_maneuver``; owner ``<sc>.<label>``), m/s
+maneuver_epoch  offset (s) of that maneuver's firing from its logged epoch (``add_maneuver(sigma_epoch=)``);
+                first order in the offset, the segment still starts at the logged epoch
+                (:mod:`.segment`)
 clock           one-way oscillator: ``info['oscillator']`` 'bias' (Hz) or 'drift' (Hz/s); nominal
                 frequency and reference epoch from ``setup.oscillators[sc]``
 bias            measurement bias along the line of sight (m for range, m/s for Doppler) of the rows
@@ -18,7 +21,7 @@ station         ITRS offset (m) of station ``owner`` from the catalog, ``info['a
 media           offset of the media scale from ``setup.media_scale`` (linear, exact)
 ==============  =================================================================================
 
-Other kinds (``maneuver_epoch``, ``eop``) are refused. Linear kinds enter as
+Other kinds (``eop``) are refused. Linear kinds enter as
 ``computed + H x`` (exact for biases and the media scale; station offsets to first order).
 
 Efficiency and exactness. The arc is cut into segments at the epochs where the
@@ -53,7 +56,7 @@ from odpipe.measurements import MeasurementSetup, compute, residuals
 from .segment import SegmentTrajectory
 
 _LINEAR = ("bias", "station", "media")
-_REFERENCE = ("dynamic", "stochastic", "maneuver", "clock")
+_REFERENCE = ("dynamic", "stochastic", "maneuver", "maneuver_epoch", "clock")
 _SUPPORTED = ("state",) + _LINEAR + _REFERENCE
 
 
@@ -121,9 +124,12 @@ class TrackingProblem:
         out["stochastic"] = [stoch[a] for a in "RTN"] if stoch else []
         man: dict = {}
         for i, p in enumerate(params):
-            if p.kind == "maneuver" and p.owner.startswith(sc + "."):
-                man.setdefault(float(p.epoch), {})[p.name[-1]] = i
+            if p.kind in ("maneuver", "maneuver_epoch") and p.owner.startswith(sc + "."):
+                man.setdefault(float(p.epoch), {})["t" if p.kind == "maneuver_epoch" else p.name[-1]] = i
+        if any(set(d) - {"t"} != set("xyz") for d in man.values()):
+            raise ValueError(f"{sc}: every maneuver needs dv_x, dv_y, dv_z (an epoch offset alone is not a maneuver)")
         out["maneuvers"] = {t: [d[a] for a in "xyz"] for t, d in man.items()}
+        out["maneuver_epochs"] = {t: d["t"] for t, d in man.items() if "t" in d}
         out["oscillator"] = {p.info["oscillator"]: i for i, p in enumerate(params)
                              if p.kind == "clock" and p.owner == sc}
         return out
@@ -188,10 +194,13 @@ class TrackingProblem:
         for sc, ix in self._sc.items():
             fm, names, idx = self._segment_model(sc, x0, a, b)
             dv_idx = ix["maneuvers"].get(a)
+            dt_idx = ix["maneuver_epochs"].get(a)
             dv = x0[dv_idx] if dv_idx is not None else None
-            trajs[sc] = SegmentTrajectory(x0[ix["state"]], a, b, fm, names, dv, self.lookback, self.rtol, self.atol)
+            dt = x0[dt_idx] if dt_idx is not None else None
+            trajs[sc] = SegmentTrajectory(x0[ix["state"]], a, b, fm, names, dv, self.lookback, self.rtol,
+                                          self.atol, dt=dt)
             trajs[sc].preload(self.epochs[(self.epochs > a) & (self.epochs <= b)])
-            pidx[sc] = np.array(idx + (dv_idx or []), int)
+            pidx[sc] = np.array(idx + (dv_idx or []) + ([dt_idx] if dt_idx is not None else []), int)
             self.n_propagations += 1
         return b, trajs, pidx
 

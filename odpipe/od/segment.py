@@ -12,8 +12,17 @@ the measurement models read, with
 
 * ``stm(t) = d x(t) / d x(a-)`` (6x6), on both sides of ``a``;
 * ``sensitivity(t) = d x(t) / d p`` for ``param_names`` = the force model's
-  parameters, then ``dv.x|y|z`` of a maneuver at ``a`` (ICRF m/s): its columns
-  are ``stm(t)[:, 3:6]`` after ``a`` and zero before.
+  parameters, then ``dv.x|y|z`` of a maneuver at ``a`` (ICRF m/s), then ``dv.dt``,
+  the offset (s) of its firing epoch when that is estimated; all zero before ``a``.
+
+A burn logged at ``a`` that fires at ``a + dt`` is kept at the segment start:
+forces depend on position only, so to first order in ``dt`` the post-burn
+branch extrapolated back to ``a`` starts from ``x(a+) = x(a-) + [-dV dt; dV]``
+(the neglected term is ``(d acc / d r) dV dt^2 / 2`` in velocity: 2e-8 m/s for 1 m/s
+and 10 s at 100,000 km from the Earth, 5e-5 m/s in low Earth orbit, where an epoch
+offset should be kept to a second or so). Hence, after ``a``, the dV columns
+are ``stm(t) [-dt I; I]`` and the epoch column is ``-stm(t)[:, 0:3] dV``. The
+reference state between ``a`` and ``a + dt`` is that post-burn branch.
 
 The look-back flies the segment's own parameters: a stochastic acceleration of
 the previous batch acts there as the current one (an error of order
@@ -29,22 +38,31 @@ import numpy as np
 from odpipe.dynamics.propagator import propagate
 
 DV_NAMES = ["dv.x", "dv.y", "dv.z"]
+DT_NAME = "dv.dt"
 
 
 class SegmentTrajectory:
     """Reference trajectory of one spacecraft over ``[a - lookback, b]`` (TDB s)."""
 
     def __init__(self, x_start, a, b, force_model, params, dv=None, lookback=120.0,
-                 rtol=1e-12, atol=1e-6):
+                 rtol=1e-12, atol=1e-6, dt=None):
+        """``dv``: ICRF dV (m/s) of a burn at ``a``; ``dt``: its estimated firing offset (s; None: not
+        estimated, the burn is at ``a``)."""
+        if dt is not None and dv is None:
+            raise ValueError("an epoch offset needs the maneuver's dV")
         self.center = force_model.center
         self.t0, self.t1 = float(a), float(b)
         self.x_start = np.asarray(x_start, float).copy()      # x(a-), m and m/s
         self.n_dv = 0 if dv is None else 3
-        self.param_names = list(params) + (DV_NAMES if dv is not None else [])
+        self.param_names = (list(params) + (DV_NAMES if dv is not None else [])
+                            + ([DT_NAME] if dt is not None else []))
         self._np = len(params)
+        self._dv = None if dv is None else np.asarray(dv, float).copy()
+        self._dt = None if dt is None else float(dt)
         x_plus = self.x_start.copy()
         if dv is not None:
-            x_plus[3:6] += dv
+            x_plus[3:6] += self._dv
+            x_plus[0:3] -= self._dv * (self._dt or 0.0)
         self._fwd = propagate(x_plus, a, b, force_model, with_stm=True, params=list(params),
                               rtol=rtol, atol=atol)
         self._back = propagate(self.x_start, a, a - lookback, force_model, with_stm=True,
@@ -87,7 +105,11 @@ class SegmentTrajectory:
             out = np.zeros((tt.size, 6, p))
             out[:, :, :self._np] = self._fwd.sensitivity(tt)
             if self.n_dv:
-                out[:, :, self._np:] = self._fwd.stm(tt)[:, :, 3:6]
+                Phi = self._fwd.stm(tt)
+                out[:, :, self._np:self._np + 3] = Phi[:, :, 3:6]
+                if self._dt is not None:
+                    out[:, :, self._np:self._np + 3] -= self._dt * Phi[:, :, 0:3]
+                    out[:, :, self._np + 3] = -Phi[:, :, 0:3] @ self._dv
             return out
 
         return self._apply(t, back, fwd, (6, p))
