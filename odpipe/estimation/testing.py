@@ -265,7 +265,7 @@ def simulate_twobody(x0, acc_batches, batch, maneuvers, times, rtol=1e-12):
 def twobody_case(rng, days=1.0, dt_obs=120.0, batch=8 * 3600.0, sig_acc=5e-9, tau=86400.0,
                  maneuvers=((10 * 3600.0, (3e-3, -2e-3, 5e-3)),), sig_range=2.0,
                  sig_rate=1e-4, dx0=(3e4, -2e4, 1e4, 0.3, -0.2, 0.1), stochastic=True,
-                 designed=None, late=None):
+                 designed=None, late=None, sigma_state=(1e5, 1.0)):
     """Simulated two-body arc (orbit radius 20,000 km) tracked by three DSN-like stations.
 
     maneuvers: (logged epoch, true dV); designed: a priori dV per maneuver (default 0);
@@ -273,7 +273,7 @@ def twobody_case(rng, days=1.0, dt_obs=120.0, batch=8 * 3600.0, sig_acc=5e-9, ta
     parameter (sigma 10 s). Returns (problem, observations, truth) where truth holds
     the epoch vector in registry order and the per-batch accelerations. A priori as
     ARTEMIS Table 4.1: 100 km, 1 m/s, 5e-9 m/s^2 accelerations, 10 mm/s and 10 s
-    maneuvers, 5 m range biases.
+    maneuvers, 5 m range biases; ``sigma_state`` (m, m/s) replaces the state's.
     """
     from .fit import Observations
 
@@ -281,7 +281,7 @@ def twobody_case(rng, days=1.0, dt_obs=120.0, batch=8 * 3600.0, sig_acc=5e-9, ta
     v = np.sqrt(MU_EARTH / r)
     x_nom = np.array([r, 0, 0, 0, v * np.cos(inc), v * np.sin(inc)])
     reg = ParameterRegistry()
-    reg.add_state("sc", x_nom, 1e5, 1.0)
+    reg.add_state("sc", x_nom, *sigma_state)
     if stochastic:
         reg.add_stochastic_acceleration("sc", sig_acc, tau, batch, axes=("x", "y", "z"))
     designed = [(0.0, 0.0, 0.0)] * len(maneuvers) if designed is None else designed

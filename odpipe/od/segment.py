@@ -22,7 +22,10 @@ branch extrapolated back to ``a`` starts from ``x(a+) = x(a-) + [-dV dt; dV]``
 and 10 s at 100,000 km from the Earth, 5e-5 m/s in low Earth orbit, where an epoch
 offset should be kept to a second or so). Hence, after ``a``, the dV columns
 are ``stm(t) [-dt I; I]`` and the epoch column is ``-stm(t)[:, 0:3] dV``. The
-reference state between ``a`` and ``a + dt`` is that post-burn branch.
+reference state between ``a`` and ``a + dt`` is that post-burn branch, and before ``a``
+the pre-burn one: rows between the logged and the actual firing see the wrong side of
+the burn (a velocity error of dV), so leave them out, as is done around burns, or let
+the editing reject them.
 
 The look-back flies the segment's own parameters: a stochastic acceleration of
 the previous batch acts there as the current one (an error of order
