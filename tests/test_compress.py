@@ -257,8 +257,10 @@ def test_grail_odf_compression(shared_data):
     assert rms1 / np.sqrt(60) < rms60 < rms1
 
 
-def test_running_doppler_counts_become_exact_doppler_in_hz():
-    # TRK-2-34 style: cycles of (Doppler + 1 MHz bias) accumulated from 0 at the first record, every 10 s
+@pytest.mark.parametrize("pass_id", [0, -1], ids=["given-pass", "assigned-pass"])
+def test_running_doppler_counts_become_exact_doppler_in_hz(pass_id):
+    # TRK-2-34 style: cycles of (Doppler + 1 MHz bias) accumulated from 0 at the first record, every 10 s;
+    # the origin sample (count time 0) belongs to the pass its counts continue (the demo lost one window a pass)
     bias, dt = 1.0e6, 10.0
     t_s = np.arange(0.0, 600.0 + dt, dt)
     doppler = lambda t: 3000.0 + 2.0 * t + 50.0 * np.sin(t / 40.0)        # Hz, DSN sign
@@ -267,10 +269,11 @@ def test_running_doppler_counts_become_exact_doppler_in_hz():
     epoch = np.datetime64("2010-11-20T04:38:00", "ns") + (t_s * 1e9).astype("timedelta64[ns]")
     tab = build(n, epoch=epoch, tag="interval_end", observable="doppler_count_2way", value=cycles(t_s), unit="cycles",
                 count_time=np.r_[0.0, np.full(n - 1, dt)], station_tx="DSS-24", station_rx="DSS-24",
-                spacecraft="2", band_up="S", band_down="S", pass_id=0, record=np.arange(n), doppler_bias_hz=bias,
+                spacecraft="2", band_up="S", band_down="S", pass_id=pass_id, record=np.arange(n), doppler_bias_hz=bias,
                 media_m=np.r_[0.0, np.diff(0.5 * t_s**0.5)])    # delay change over each count interval
-    out, _ = compress(tab, 60.0)
+    out, report = compress(tab, 60.0)
     dop = out[out["observable"] == "doppler_2way"]
+    assert report.dropped.empty
     assert len(dop) == 10 and (dop["unit"] == "Hz").all() and (dop["count_time"] == 60.0).all()
     start = (dop["epoch"].to_numpy() - epoch[0]) / np.timedelta64(1, "s") - 30.0   # tags are interval middles
     exact = (cycles(start + 60.0) - cycles(start)) / 60.0 - bias

@@ -61,8 +61,12 @@ def assign_passes(table: pd.DataFrame, ramps: pd.DataFrame | None = None, *, max
     spacing = step[same].groupby(link[order][1:][same]).median()  # s, each link's usual sample spacing
     allowed = np.maximum(max_gap, gap_factor * pd.Series(link[order][1:]).map(spacing).fillna(0).to_numpy())
     new[1:] |= gap_s > allowed
-    for col in (link, out["count_time"].to_numpy(dtype=float), out["ramped"].to_numpy(dtype=bool),
-                out["uplink_hz"].to_numpy(dtype=float), jumps):
+    # a zero count time (the origin sample of running counts) takes its link's next count time: it opens
+    # the pass its counts continue instead of making a pass of its own
+    ct = pd.Series(out["count_time"].to_numpy(dtype=float)[order]).replace(0.0, np.nan)
+    ct = ct.groupby(link[order]).bfill().fillna(0.0).to_numpy()
+    new |= _changed(ct)
+    for col in (link, out["ramped"].to_numpy(dtype=bool), out["uplink_hz"].to_numpy(dtype=float), jumps):
         new |= _changed(np.asarray(col)[order])
     pass_sorted = np.cumsum(new) - 1
     pid = np.empty(len(out), dtype=np.int64)
