@@ -236,7 +236,7 @@ def _solution(setup, reg, problem, sol, rows, times, to_los, status) -> ArcSolut
                         "observable": rows["observable"].to_numpy(), "station_rx": rows["station_rx"].to_numpy(),
                         "pass_id": rows["pass_id"].to_numpy(), "time": times, "to_los": to_los,
                         "status": status})
-    for col in ("prefit", "postfit", "sigma"):
+    for col in ("prefit", "postfit", "sigma", "innovation", "innovation_sigma"):
         res[col] = np.nan
         res.loc[good, col] = sol.residuals[col].to_numpy()
     res["prefit_los"] = res["prefit"] * res["to_los"]

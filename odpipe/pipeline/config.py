@@ -117,6 +117,9 @@ class EstimationSection:
     max_iter: int = 10
     reweight: bool = False  # ARTEMIS reweighting from post-fit RMS; see README (known instability)
     block: float = 600.0
+    # unlogged maneuvers: the filter's innovations are always tested (findings in the report); with a sigma
+    # (m/s per axis) each finding also becomes an estimated impulsive maneuver and the arc is fitted again
+    detected_maneuver_sigma: float | None = None
 
 
 @dataclass

@@ -12,16 +12,18 @@ from __future__ import annotations
 
 import json
 import time
+from dataclasses import replace
 from pathlib import Path
 
 import numpy as np
 import pandas as pd
 
 from odpipe.analysis import maneuvers as maneuver_report
+from odpipe.estimation.maneuvers import detect_maneuvers
 from odpipe.media.apply import calibrate
 from odpipe.media.ionosphere import IonexModel
 from odpipe.media.model import MediaModel
-from odpipe.od.arc import fit_arc
+from odpipe.od.arc import ManeuverPlan, fit_arc
 from odpipe.pipeline import setup as build
 from odpipe.pipeline.config import RunConfig, load_config
 from odpipe.pipeline.geometry import add_geometry
@@ -36,6 +38,7 @@ from odpipe.products.oem import write_oem
 from odpipe.products.spk import write_spk
 from odpipe.runs import rundir
 from odpipe.runs.report import Section, write_report
+from odpipe.time import tdb_to_utc
 from parsers.ionex import read_ionex
 from parsers.trk223 import read_trk223
 
@@ -117,15 +120,59 @@ def _run(cfg: RunConfig, attempt, log: RunLog) -> dict:
     log("edit: " + ", ".join(f"{r} {n}" for r, n in zip(edits["reason"], edits["rows"]) if n))
 
     t0 = time.perf_counter()
-    arc = fit_arc(table, setup)
+    arc = _fit(table, setup, log)
+    findings = unlogged_maneuvers(arc.residuals)
+    log(f"innovation test for unlogged maneuvers: {len(findings)} finding(s)")
+    sigma = cfg.estimation.detected_maneuver_sigma
+    if len(findings) and sigma is not None:
+        added = tuple(_detected_plan(k, f.after_tdb, f.epoch_tdb, sigma) for k, f in enumerate(findings.itertuples()))
+        log(f"refit with {len(added)} detected maneuver(s) estimated ({sigma} m/s per axis a priori)")
+        arc = _fit(table, replace(setup, maneuvers=tuple(setup.maneuvers) + added), log)
     fit_seconds = time.perf_counter() - t0
+    return _products(cfg, attempt, log, table, arc, edits, fit_seconds, findings)
+
+
+MAX_EPOCH_WINDOW_S = 600.0  # s: a burn found between rows closer than this also gets its epoch estimated
+
+
+def _detected_plan(k: int, after: float, epoch: float, sigma: float) -> ManeuverPlan:
+    """The impulsive maneuver estimated for a finding: in the middle of the window between the last quiet
+    row and the first excess row, its epoch estimated within half that window; after a longer gap (no
+    data to place it) at the gap's start, epoch not estimated."""
+    half = 0.5 * (epoch - after)
+    if 2 * half <= MAX_EPOCH_WINDOW_S:
+        return ManeuverPlan(f"detected{k}", after + half, sigma=sigma, sigma_epoch=max(half, 1.0))
+    return ManeuverPlan(f"detected{k}", after, sigma=sigma)
+
+
+def _fit(table, setup, log):
+    t0 = time.perf_counter()
+    arc = fit_arc(table, setup)
     for h in arc.history:
         log(f"fit iteration: {json.dumps(h, default=float)}")
-    log(f"fit: {'converged' if arc.converged else 'NOT converged'} in {len(arc.history)} iterations, {fit_seconds:.1f} s")
-    return _products(cfg, attempt, log, table, arc, edits, fit_seconds)
+    log(f"fit: {'converged' if arc.converged else 'NOT converged'} in {len(arc.history)} iterations, "
+        f"{time.perf_counter() - t0:.1f} s")
+    return arc
 
 
-def _products(cfg, attempt, log, table, arc, edits, fit_seconds) -> dict:
+def unlogged_maneuvers(res: pd.DataFrame, window: int = 20, p_false: float = 1e-6) -> pd.DataFrame:
+    """Suspected unlogged maneuvers: the chi-square window test of
+    :func:`odpipe.estimation.maneuvers.detect_maneuvers` on the filter's normalized innovations of the
+    fitted rows. Columns: ``after_tdb`` (last quiet row) and ``epoch_tdb`` (first excess row), TDB s,
+    their UTC ``after``/``epoch``, ``statistic`` and ``threshold`` (chi-square over ``window`` rows)."""
+    ok = (res["status"] == "") & np.isfinite(res["innovation"]) & (res["innovation_sigma"] > 0)
+    r = res[ok].sort_values("time", kind="stable")
+    found = detect_maneuvers(r["time"].to_numpy(), (r["innovation"] / r["innovation_sigma"]).to_numpy(),
+                             window, p_false)
+    out = pd.DataFrame([{"after_tdb": f.after, "epoch_tdb": f.epoch, "statistic": f.statistic,
+                         "threshold": f.threshold} for f in found],
+                       columns=["after_tdb", "epoch_tdb", "statistic", "threshold"])
+    for col in ("after", "epoch"):
+        out.insert(len(out.columns), col, tdb_to_utc(out[f"{col}_tdb"].to_numpy(float)) if len(out) else [])
+    return out
+
+
+def _products(cfg, attempt, log, table, arc, edits, fit_seconds, findings) -> dict:
     res = arc.residuals
     stats = residuals.statistics(res)
     table.to_parquet(attempt.product("tracking.parquet"))
@@ -162,6 +209,16 @@ def _products(cfg, attempt, log, table, arc, edits, fit_seconds) -> dict:
     for png, caption in figures:
         sections[0].figure(png, caption)
     sections.append(Section("Estimated parameters").table(params))
+    write_text(attempt.product("unlogged_maneuvers.csv"), findings.to_csv(index=False))
+    detected = Section("Unlogged maneuvers (innovation test)")
+    detected.text(f"{len(findings)} finding(s): runs of 20 normalized filter innovations beyond the chi-square "
+                  "1e-6 quantile" + ("; each was estimated as an impulsive maneuver (see the parameters)"
+                                     if len(findings) and cfg.estimation.detected_maneuver_sigma is not None
+                                     else ("; not estimated (estimation.detected_maneuver_sigma unset)"
+                                           if len(findings) else ".")))
+    if len(findings):
+        detected.table(findings[["after", "epoch", "statistic", "threshold"]])
+    sections.append(detected)
     if man_stats is not None:
         sections.append(Section("Maneuvers (designed − estimated)").table(man_rows).table(man_stats.reset_index()))
     write_report(attempt.product("report.html"), f"odpipe run {cfg.run.name}", summary, sections)
