@@ -40,15 +40,12 @@ import numpy as np  # noqa: E402
 
 from dataclasses import replace  # noqa: E402
 
-from odpipe.dynamics.forces import (EmpiricalRTN, ForceModel, ImpulsiveManeuver, PointMasses,  # noqa: E402
-                                    SolarRadiationPressure, SphericalHarmonics)
+from odpipe.dynamics.forces import ForceModel, PointMasses, SolarRadiationPressure, SphericalHarmonics  # noqa: E402
 from odpipe.dynamics.propagator import propagate  # noqa: E402
 from odpipe.environment.gravity import read_gravity  # noqa: E402
-from odpipe.estimation.registry import GaussMarkov  # noqa: E402
 from odpipe.measurements import MeasurementSetup  # noqa: E402
-from odpipe.od import ArcSetup, ManeuverPlan, TrackingPlan, fit_arc, simulate_tracking  # noqa: E402
-from odpipe.simulate.case import load  # noqa: E402
-from odpipe.simulate.truth import simulate_truth  # noqa: E402
+from odpipe.od import ArcSetup, TrackingPlan, fit_arc, simulate_tracking  # noqa: E402
+from odpipe.od.simulate import libration_arc  # noqa: E402
 from odpipe.time import utc_to_tdb  # noqa: E402
 
 ROOT = Path(__file__).resolve().parents[1]
@@ -124,37 +121,10 @@ def peers_case():
         print(f"  post-fit RMS {obs:13s} {np.sqrt(np.mean(g['postfit_los'] ** 2)):.3e} (m or m/s)")
 
 
-def long_arc_case():
-    """14-day libration arc: truth, the tracking table (with a mis-weighted station and blunders), the arc set-up."""
-    setup = MeasurementSetup.default()
-    art = load(ROOT / "runs" / "artemis_p2_like.toml").shortened(14.0)
-    rng = np.random.default_rng(art.seed)
-    truth = simulate_truth(art, setup.ephemeris, rng)
-    plan = TrackingPlan(("DSS-14", "DSS-43", "DSS-63"), art.start, art.end - np.timedelta64(60, "s"),
-                        doppler_step=240.0, range_step=1200.0, sigma_doppler=1e-4, sigma_range=2.0,
-                        range_bias_sigma=5.0, spacecraft="SC")
-    table, _ = simulate_tracking(truth.trajectory, plan, setup, rng)
-    noisy = ((table["station_rx"] == "DSS-43") & (table["observable"] == "doppler_2way")).to_numpy()
-    table.loc[noisy, "value"] += np.sqrt(3.0) * table.loc[noisy, "sigma"] * rng.standard_normal(noisy.sum())
-    dop = np.flatnonzero((table["observable"] == "doppler_2way").to_numpy() & ~noisy)
-    blunders = table.index[dop[rng.choice(dop.size, 5, replace=False)]]
-    table.loc[blunders, "value"] += 30.0 * table.loc[blunders, "sigma"]
-    nominal = [c for c in truth.force_model.components if not isinstance(c, (EmpiricalRTN, ImpulsiveManeuver))]
-    t0, t1 = float(utc_to_tdb(art.start)), float(utc_to_tdb(art.end))
-    x0 = truth.trajectory.state(np.array([t0]))[0]
-    st = art.stochastic
-    arc = ArcSetup("SC", t0, t1, x0 + np.array([1e3, -1e3, 1e3, 1e-2, -1e-2, 1e-2]) / np.sqrt(3.0),
-                   replace(truth.force_model, components=nominal), setup,
-                   stochastic=GaussMarkov(float(st["tau_s"]), float(st["sigma"]), float(st["batch_s"])),
-                   maneuvers=tuple(ManeuverPlan(m["name"], float(e), tuple(m["dv"]), 0.01, 10.0)
-                                   for m, e in zip(truth.maneuvers, truth.epochs)),
-                   lookback=300.0, data_sigma={"range": 2.0, "doppler_2way": 1e-4})
-    return truth, table, set(blunders), arc
-
-
 def long_arc():
     s = time.perf_counter()
-    truth, table, blunders, arc = long_arc_case()
+    case = libration_arc(14.0)
+    truth, table, blunders, arc = case["truth"], case["table"], case["blunders"], case["setup"]
     print(f"14-day L1 libration arc: {len(table)} rows {table['observable'].value_counts().to_dict()}, "
           f"{len(truth.epochs)} burns; simulated in {time.perf_counter() - s:.1f} s")
     for reweight in (False, True):
