@@ -44,6 +44,7 @@ from odpipe.dynamics.forces import ForceModel, PointMasses, SolarRadiationPressu
 from odpipe.dynamics.propagator import propagate  # noqa: E402
 from odpipe.environment.gravity import read_gravity  # noqa: E402
 from odpipe.measurements import MeasurementSetup  # noqa: E402
+import odpipe.od.arc as arc_module  # noqa: E402
 from odpipe.od import ArcSetup, TrackingPlan, fit_arc, simulate_tracking  # noqa: E402
 from odpipe.od.simulate import libration_arc  # noqa: E402
 from odpipe.time import utc_to_tdb  # noqa: E402
@@ -127,12 +128,25 @@ def long_arc():
     truth, table, blunders, arc = case["truth"], case["table"], case["blunders"], case["setup"]
     print(f"14-day L1 libration arc: {len(table)} rows {table['observable'].value_counts().to_dict()}, "
           f"{len(truth.epochs)} burns; simulated in {time.perf_counter() - s:.1f} s")
+    calls = []                                  # (days, iterations, s) of each fit inside fit_arc
+    fit = arc_module.fit
+
+    def timed_fit(problem, obs, t_start, t_end, options, x_ref=None):
+        s = time.perf_counter()
+        sol = fit(problem, obs, t_start, t_end, options, x_ref=x_ref)
+        calls.append(((t_end - t_start) / 86400.0, len(sol.history), time.perf_counter() - s))
+        return sol
+
+    arc_module.fit = timed_fit
     for reweight in (False, True):
+        calls.clear()
         s, c = time.perf_counter(), time.process_time()
         sol = fit_arc(table, replace(arc, reweight=reweight))
         total, cpu = time.perf_counter() - s, time.process_time() - c
         print(f"reweight={reweight}: {len(sol.registry)} parameters, {len(sol.history)} iterations of the full arc "
               f"(after the growing arcs), converged={sol.converged}, {total:.1f} s wall, {cpu:.1f} s CPU")
+        print("    fits (days, iterations, s/iteration): "
+              + ", ".join(f"({d:g}, {n}, {t / n:.2f})" for d, n, t in calls))
         for h in sol.history:
             print(f"    iteration {h['iteration']}: prefit RMS {h['prefit_rms']:9.3f}  postfit RMS "
                   f"{h['postfit_rms']:7.4f}  edited {h['edited']:3d} (k {h['edit_k']:g})  "
