@@ -7,7 +7,10 @@ two-way X-band Doppler every 60 s (0.1 mm/s, 60 s count); start 0.7 km / 0.54 m/
 priori 1 km / 1 m/s / Cr 0.1. Estimated: epoch state and SRP scale. Printed: simulation
 time, wall time per iteration, total fit time, measurements per second (rows x iterations
 / s) and errors vs truth. Peers on the same case (lead, idle machine, 2026-11-22): Orekit
-filter + RTS 47.7 s, nyx EKF 3.1 s and diverged (5 of 12,149 accepted).
+filter + RTS 47.7 s, nyx EKF 3.1 s and diverged (5 of 12,149 accepted). Back to back in one
+session (2026-11-22 10:53-10:56 UTC, load average 1.5-2.3 on 2 cores shared by other jobs):
+odpipe 1.63 s (2 iterations, final error 3.1 m), nyx EKF 3.94 s + RTS 0.14 s (diverged, 5
+accepted), Orekit filter + RTS 62.2 s + 0.34 s (final error 5.1 m): ratios 2.5 and 38.
 
 ``long``: a 14-day ARTEMIS-P2-like Earth-Moon L1 arc (runs/artemis_p2_like.toml truth:
 cylinder SRP, Gauss-Markov accelerations, two station-keeping burns and an attitude burn

@@ -67,6 +67,15 @@ def test_registry_carries_the_epoch_offset_of_the_maneuver_plan(case):
     assert build_registry(_setup(case, None), rows).indices("maneuver_epoch").size == 0
 
 
+def test_an_epoch_offset_without_its_dv_is_refused(case):
+    setup = _setup(case, None)
+    rows, times = select_rows(case["table"], setup)
+    reg = build_registry(setup, rows)
+    reg.add("SC.tcm2.dt", "maneuver_epoch", 0.0, 10.0, owner="SC.tcm2", epoch=case["t_man"] + 3600.0)
+    with pytest.raises(ValueError, match="epoch offset alone"):
+        TrackingProblem(reg, rows, times, {"SC": force_model()}, setup.measurements, case["t0"], case["t1"])
+
+
 def test_late_burn_state_and_partials_match_integrations_that_fire_late(case):
     setup = _setup(case)
     rows, times = select_rows(case["table"], setup)
