@@ -18,6 +18,8 @@ from odpipe.dynamics.forces import ImpulsiveManeuver
 from odpipe.dynamics.propagator import propagate
 from odpipe.od import ArcSetup, ManeuverPlan, TrackingPlan, TrackingProblem, fit_arc, simulate_tracking
 from odpipe.od.arc import build_registry, select_rows
+from odpipe.od.segment import SegmentTrajectory
+from odpipe.dynamics.forces import ForceModel
 from test_od_simulate import (PERIGEE_UTC, PERTURBATION, STATIONS, TRUE_SRP_SCALE, X_PERIGEE, force_model,
                               measurement_setup)
 from odpipe.time import utc_to_tdb
@@ -92,9 +94,9 @@ def test_late_burn_state_and_partials_match_integrations_that_fire_late(case):
     for dt in (0.0, LATE, -LATE):
         x_man[i_dt] = dt
         x1, Phi = prob.transition(t_man, t1, x_man)
-        # first order in dt: the late burn is reproduced to millimetres after 6 h (a 2.8 km displacement)
+        # the late burn is reproduced after 6 h (a 2.8 km displacement) to the integration noise
         err = x1[:6] - _fire(x_pre, t_man, t_man + dt, t1, DV)
-        assert np.max(np.abs(err[:3])) < 2e-3 and np.max(np.abs(err[3:])) < 1e-6, (dt, err)
+        assert np.max(np.abs(err[:3])) < 1e-4 and np.max(np.abs(err[3:])) < 1e-9, (dt, err)
         # d x(t1) / d dt against central differences of the firing epoch (h = 5 s; the integrations' noise,
         # rtol 1e-12 of 2e8 m, is 2e-5 m/s per s of the 0.3 m/s per s partial)
         fd = (_fire(x_pre, t_man, t_man + dt + 5.0, t1, DV) - _fire(x_pre, t_man, t_man + dt - 5.0, t1, DV)) / 10.0
@@ -130,3 +132,33 @@ def test_without_the_epoch_parameter_the_late_burn_leaves_a_misfit(case, fitted)
     (measured: normalized post-fit RMS 7.3 against 1.0, dV off by 5 sigma)."""
     held = fit_arc(case["table"], _setup(case, None))
     assert held.history[-1]["postfit_rms"] > 3.0 * fitted.history[-1]["postfit_rms"]
+
+
+def test_low_orbit_burn_fired_late_is_flown_exactly():
+    """7,000 km circular orbit, a 10 m/s burn 10 s late: the first-order start x(a-) + [-dV dt; dV]
+    would be 6e-4 m/s off (gravity gradient 1.2e-6 /s^2 times dV dt^2 / 2); the segment flies the burn."""
+    fm = ForceModel("earth", [], mass=500.0, ephemeris=measurement_setup().ephemeris)
+    gm = 3.986004418e14
+    r = 7.0e6
+    x_pre = np.array([r, 0.0, 0.0, 0.0, np.sqrt(gm / r), 0.0])
+    dv, dt, a, t1 = np.array([2.0, 10.0, -3.0]), 10.0, 1.0e8, 1.0e8 + 3000.0
+
+    def flown(x0, t0):
+        return propagate(x0, t0, t1, fm, with_stm=False).state(t1)[0]
+
+    x_fire = propagate(x_pre, a, a + dt, fm, with_stm=False).state(a + dt)[0]
+    x_fire[3:] += dv
+    expected = flown(x_fire, a + dt)
+    seg = SegmentTrajectory(x_pre, a, t1, fm, [], dv=dv, dt=dt)
+    got = seg.state(np.array([t1]))[0]
+    assert np.max(np.abs(got - expected)[:3]) < 1e-3 and np.max(np.abs(got - expected)[3:]) < 1e-6   # integration noise
+    first_order = flown(x_pre + np.concatenate([-dv * dt, dv]), a)
+    assert np.max(np.abs(first_order - expected)) > 1.0          # metres: the exact start matters here
+    # the epoch partial is first order (-stm(t, a) dV instead of -stm(t, a + dt) dV): off by about the
+    # orbital rate times dt, 1e-3 /s x 10 s = 1 % here (measured 1.7 %); it only sets the convergence rate,
+    # the converged estimate rests on the exact reference above
+    fd = (flown(propagate(x_pre, a, a + dt + 1, fm, with_stm=False).state(a + dt + 1)[0] + np.r_[0, 0, 0, dv], a + dt + 1)
+          - flown(propagate(x_pre, a, a + dt - 1, fm, with_stm=False).state(a + dt - 1)[0] + np.r_[0, 0, 0, dv],
+                  a + dt - 1)) / 2.0
+    S = seg.sensitivity(np.array([t1]))[0]
+    assert np.max(np.abs(S[:, 3] - fd)) < 0.03 * np.max(np.abs(fd))

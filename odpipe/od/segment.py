@@ -15,17 +15,21 @@ the measurement models read, with
   parameters, then ``dv.x|y|z`` of a maneuver at ``a`` (ICRF m/s), then ``dv.dt``,
   the offset (s) of its firing epoch when that is estimated; all zero before ``a``.
 
-A burn logged at ``a`` that fires at ``a + dt`` is kept at the segment start:
-forces depend on position only, so to first order in ``dt`` the post-burn
-branch extrapolated back to ``a`` starts from ``x(a+) = x(a-) + [-dV dt; dV]``
-(the neglected term is ``(d acc / d r) dV dt^2 / 2`` in velocity: 2e-8 m/s for 1 m/s
-and 10 s at 100,000 km from the Earth, 5e-5 m/s in low Earth orbit, where an epoch
-offset should be kept to a second or so). Hence, after ``a``, the dV columns
-are ``stm(t) [-dt I; I]`` and the epoch column is ``-stm(t)[:, 0:3] dV``. The
-reference state between ``a`` and ``a + dt`` is that post-burn branch, and before ``a``
-the pre-burn one: rows between the logged and the actual firing see the wrong side of
-the burn (a velocity error of dV), so leave them out, as is done around burns, or let
-the editing reject them.
+A burn logged at ``a`` that fires at ``a + dt`` is kept at the segment start: the
+post-burn branch is flown back to ``a`` (pre-burn flight from ``a`` to ``a + dt``, dV added
+there, post-burn flight back to ``a``), which is exact, and starts the forward
+integration as ``x(a+)``. Its partials are first order in ``dt``: forces depend on
+position only, so ``x(a+) = x(a-) + [-dV dt; dV]`` up to ``(d acc / d r) dV dt^2 / 2`` in
+velocity (2e-8 m/s for 1 m/s and 10 s at 100,000 km from the Earth, 5e-4 m/s for
+10 m/s in low Earth orbit), and after ``a`` the dV columns are ``stm(t) [-dt I; I]`` and
+the epoch column ``-stm(t)[:, 0:3] dV``; ``stm`` is that of the post-burn branch from
+``a`` (``d x(a+) / d x(a-)`` taken as the identity, relative error of order
+``(d acc / d r) dt^2``). The epoch column is off by about the orbital rate times ``dt``
+(1 % for 10 s in low orbit): that sets the convergence rate only, the converged
+estimate rests on the exact reference. The reference state between ``a`` and ``a + dt`` is the
+post-burn branch, and before ``a`` the pre-burn one: rows between the logged and the
+actual firing see the wrong side of the burn (a velocity error of dV), so leave them
+out, as is done around burns, or let the editing reject them.
 
 The look-back flies the segment's own parameters: a stochastic acceleration of
 the previous batch acts there as the current one (an error of order
@@ -63,9 +67,14 @@ class SegmentTrajectory:
         self._dv = None if dv is None else np.asarray(dv, float).copy()
         self._dt = None if dt is None else float(dt)
         x_plus = self.x_start.copy()
-        if dv is not None:
+        if self._dt:
+            t_fire = a + self._dt
+            x_fire = propagate(self.x_start, a, t_fire, force_model, with_stm=False, rtol=rtol,
+                               atol=atol).state(t_fire)[0]
+            x_fire[3:6] += self._dv
+            x_plus = propagate(x_fire, t_fire, a, force_model, with_stm=False, rtol=rtol, atol=atol).state(a)[0]
+        elif dv is not None:
             x_plus[3:6] += self._dv
-            x_plus[0:3] -= self._dv * (self._dt or 0.0)
         self._fwd = propagate(x_plus, a, b, force_model, with_stm=True, params=list(params),
                               rtol=rtol, atol=atol)
         self._back = propagate(self.x_start, a, a - lookback, force_model, with_stm=True,
