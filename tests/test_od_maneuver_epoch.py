@@ -1,9 +1,10 @@
 """Maneuver epoch as an estimated parameter (seed 004 Table 4.1: 10 s a priori).
 
-A burn logged at ``a`` that fires at ``a + dt``: the problem keeps the segment at ``a``
-and starts the post-burn branch from ``x(a-) + [-dV dt; dV]``. Checked here against
-fresh integrations that really fire the burn at ``a + dt`` (pre-burn flight to ``a + dt``,
-dV added there), and by fitting tracking simulated with a burn fired 6 s late.
+A burn logged at ``a`` that fires at ``a + dt``: the problem keeps the segment at ``a``,
+flies the post-burn branch back to ``a`` and uses partials first order in ``dt``
+(``x(a+) = x(a-) + [-dV dt; dV]``). Checked here against fresh integrations that really
+fire the burn at ``a + dt`` (pre-burn flight to ``a + dt``, dV added there), and by
+fitting tracking simulated with a burn fired 6 s late.
 
 Case: the peers' cislunar HEO of ``test_od_simulate`` (DSS-14/43/63, Doppler 0.1 mm/s,
 range 1 m with 3 m per-pass biases), 2 days, a 0.47 m/s burn 0.8 day in.

@@ -11,8 +11,8 @@ dynamic         a force-model parameter: ``info['model']`` in ``srp_scale``, ``r
 stochastic      RTN accelerations (``registry.add_stochastic_acceleration``, axes R, T, N), m/s^2
 maneuver        impulsive ICRF dV (``registry.add_maneuver``; owner ``<sc>.<label>``), m/s
 maneuver_epoch  offset (s) of that maneuver's firing from its logged epoch (``add_maneuver(sigma_epoch=)``);
-                first order in the offset, the segment still starts at the logged epoch
-                (:mod:`.segment`)
+                the segment still starts at the logged epoch; reference exact, partials first
+                order in the offset (:mod:`.segment`)
 clock           one-way oscillator: ``info['oscillator']`` 'bias' (Hz) or 'drift' (Hz/s); nominal
                 frequency and reference epoch from ``setup.oscillators[sc]``
 bias            measurement bias along the line of sight (m for range, m/s for Doppler) of the rows
