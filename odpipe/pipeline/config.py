@@ -113,6 +113,7 @@ class EstimationSection:
     data_sigma: dict[str, float] = field(default_factory=lambda: {"range": 2.0, "doppler_2way": 1e-4})
     range_bias_sigma: float | None = 5.0
     maneuver_plan: Path | None = None  # planned maneuvers (parsers.maneuvers schema)
+    maneuver_epoch_sigma: float | None = None  # s: estimate planned burns' epochs (a plan's sigma_time wins)
     edit_k: list[float] = field(default_factory=lambda: [float("inf"), 10.0, 5.0])
     max_iter: int = 10
     reweight: bool = False  # ARTEMIS reweighting from post-fit RMS; see README (known instability)

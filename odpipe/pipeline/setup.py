@@ -68,7 +68,10 @@ def maneuver_plans(cfg: RunConfig, fm: F.ForceModel, state0: np.ndarray, t0: flo
             dv = rot.T @ dv
         applied.append(F.ImpulsiveManeuver(t, dv))
         sigma = row.sigma_dv if np.isfinite(row.sigma_dv) else 0.01
-        plans.append(ManeuverPlan(str(row.name), t, tuple(dv), float(sigma)))
+        # the epoch is estimated when the plan gives its sigma (sigma_time) or the config a default
+        sigma_t = row.sigma_time if np.isfinite(row.sigma_time) else cfg.estimation.maneuver_epoch_sigma
+        plans.append(ManeuverPlan(str(row.name), t, tuple(dv), float(sigma),
+                                  None if sigma_t is None else float(sigma_t)))
     return plans
 
 
