@@ -91,11 +91,10 @@ class _HourlyGeocentricDtdb:
             lo, hi = lo - self.PAD_H, hi + self.PAD_H
             if self.values.size and max(hi, last) - min(lo, self.first) <= self.MAX_H:
                 lo, hi = min(lo, self.first), max(hi, last)
+            if hi - lo > self.MAX_H:  # epochs over many years: the series at each one
+                return erfa.dtdb(J2000_JD, hours / 24.0, 0.0, 0.0, 0.0, 0.0)
             grid = np.arange(lo, hi + 1, dtype=float)
-            values = erfa.dtdb(J2000_JD, grid / 24.0, 0.0, 0.0, 0.0, 0.0)
-            if hi - lo > self.MAX_H:  # a span of many years: interpolate without keeping it
-                return lagrange4_uniform(float(lo), 1.0, values, hours)
-            self.first, self.values = lo, values
+            self.first, self.values = lo, erfa.dtdb(J2000_JD, grid / 24.0, 0.0, 0.0, 0.0, 0.0)
         return lagrange4_uniform(float(self.first), 1.0, self.values, hours)
 
 
