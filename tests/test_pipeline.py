@@ -6,75 +6,19 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from odpipe.dynamics.forces import ForceModel, PointMasses, SolarRadiationPressure
-from odpipe.dynamics.propagator import propagate
-from odpipe.environment.ephemeris import Ephemeris
-from odpipe.measurements import MeasurementSetup
-from odpipe.od.simulate import TrackingPlan, simulate_tracking
+from heo_case import simulate, write_config
 from odpipe.pipeline.run import run_config
-from odpipe.preprocess import store
-from odpipe.time import utc_to_tdb
 from parsers import oem
 
-# The peers' cislunar HEO (shared/peers/bench/common.py), two days after perigee.
-R0 = np.array([6252.878075666748, -360.9143112901398, 2842.206999982947]) * 1e3
-V0 = np.array([-0.559937727219993, 10.347539903919273, 2.5458376452827824]) * 1e3
-EPOCH0, START, END = "2003-06-01T00:00:00", "2003-06-03T00:00:00", "2003-06-04T12:00:00"
-
-
-def _tdb(iso):
-    return float(utc_to_tdb(np.datetime64(iso, "ns")))
+START, END = "2003-06-03T00:00:00", "2003-06-04T12:00:00"  # two days after the peers' perigee
 
 
 @pytest.fixture(scope="module")
 def case(tmp_path_factory):
     tmp = tmp_path_factory.mktemp("pipeline")
-    eph = Ephemeris.open("de440")
-    fm = ForceModel("earth", [PointMasses(["sun", "moon"]), SolarRadiationPressure(cr_area=1.3 * 5.0)], 500.0, eph)
-    t0, ts, te = _tdb(EPOCH0), _tdb(START), _tdb(END)
-    x_start = propagate(np.r_[R0, V0], t0, ts, fm, with_stm=False).state(ts)[0]
-    x_before = propagate(x_start, ts, ts - 120.0, fm, with_stm=False).state(ts - 120.0)[0]
-    truth = propagate(x_before, ts - 120.0, te + 60.0, fm, with_stm=False)  # values only: no partials needed
-    plan = TrackingPlan(("DSS-14", "DSS-43", "DSS-63"), np.datetime64(START, "ns") + np.timedelta64(60, "s"),
-                        np.datetime64(END, "ns"), spacecraft="SC1", range_bias_sigma=0.0)
-    table, _ = simulate_tracking(truth, plan, MeasurementSetup.default(), np.random.default_rng(7))
-    store.write(tmp / "tracking.parquet", table)
+    truth, x_start = simulate(tmp, START, END)
     guess = x_start + np.r_[500.0, -400.0, 300.0, 0.004, -0.003, 0.002]
-    (tmp / "arc.toml").write_text(f"""
-[run]
-name = "sim_arc"
-output = "out"
-[arc]
-spacecraft = "SC1"
-start = "{START}"
-end = "{END}"
-[data]
-files = ["tracking.parquet"]
-[calibration]
-media = false
-[preprocess]
-count_time = 60.0
-elevation_mask_deg = 10.0
-[dynamics]
-center = "earth"
-third_bodies = ["sun", "moon"]
-mass = 500.0
-[dynamics.srp]
-cr_area = 6.5
-[initial_state]
-epoch = "{START}"
-state = {list(map(float, guess))}
-[estimation]
-sigma_position = 1000.0
-sigma_velocity = 0.01
-srp_scale_sigma = 0.1
-data_sigma = {{ range = 1.0, doppler_2way = 1e-4 }}
-range_bias_sigma = 5.0
-reweight = false
-[products]
-naif_id = -900
-step = 300.0
-""")
+    write_config(tmp, "sim_arc", START, END, guess, "reweight = false")
     out = run_config(tmp / "arc.toml", progress=None)
     return tmp, out, truth
 
