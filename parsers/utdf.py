@@ -45,7 +45,7 @@ import pandas as pd
 
 from parsers import table as tt
 from parsers.errors import ParseError, ParseReport, check_mode, handle
-from parsers.odf import code_labels, time_ordered
+from parsers.odf import code_labels
 from parsers.table import TrackingData
 
 RECORD = 75
@@ -96,7 +96,7 @@ def read(path, errors: str = "raise") -> TrackingData:
     raw = np.frombuffer(buf, DTYPE, count=n)
     ok = _check(path, raw, errors, report)
     rec = records_frame(raw[ok], np.flatnonzero(ok))
-    table = time_ordered(_table(rec, str(path)))
+    table = _table(rec, str(path))  # already in time order
     meta = {"records": rec, "sic": sorted(set(rec["sic"].tolist())),
             "vid": sorted(set(rec["vid"].tolist()))}
     return TrackingData(table=table, ramps=tt.empty_ramps(), report=report, meta=meta)
@@ -220,9 +220,9 @@ def _table(rec: pd.DataFrame, source: str) -> pd.DataFrame:
     ctime = np.stack([np.zeros(n), count_time, np.zeros(n), np.zeros(n)], axis=1)
     doppler_name = np.where(two_way, "doppler_2way", "doppler_1way").astype(object)
     names = np.stack([np.full(n, "range", dtype=object), doppler_name, *angle_names], axis=1)
-    flat = present.ravel()
-    r = np.repeat(np.arange(n), len(KINDS))[flat]
-    k = np.tile(np.arange(len(KINDS)), n)[flat]
+    flat = np.flatnonzero(present.ravel())
+    flat = flat[np.argsort(epoch[flat // len(KINDS)], kind="stable")]  # time order, file order among equals
+    r, k = flat // len(KINDS), flat % len(KINDS)
     is_doppler = k == 1
     return tt.build(
         len(r), epoch=epoch[r], tag=TAGS[k], observable=names.ravel()[flat], value=value.ravel()[flat],
