@@ -76,6 +76,9 @@ def test_failed_attempt_keeps_previous_products(tmp_path):
     assert (tmp_path / "out" / "current" / "a.txt").read_text() == "good"
     assert "diverged" in (bad.path / "FAILED.txt").read_text()
     assert rundir.up_to_date(tmp_path / "out", fp)
+    # changed software (another odpipe or parsers source) makes the arc stale
+    assert fp["software_sha256"] == rundir.software_sha256() and len(fp["software_sha256"]) == 64
+    assert not rundir.up_to_date(tmp_path / "out", {**fp, "software_sha256": "0" * 64})
     cfg.write_text("seconds = 1\n")  # a changed config makes the arc stale
     assert not rundir.up_to_date(tmp_path / "out", rundir.fingerprint(cfg.read_text(), [cfg]))
     (tmp_path / "out" / "current" / "a.txt").write_text("tampered")  # so does an altered product

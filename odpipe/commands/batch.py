@@ -8,17 +8,23 @@ from odpipe.runs.batch import night_summary, run_batch
 from odpipe.runs.schema import ConfigError
 
 NAME = "batch"
-HELP = "run many arcs (a nightly batch config listing arc configs) in parallel; skips unchanged arcs"
+HELP = ("run many arcs (a nightly batch config listing arc configs) in parallel; skips arcs whose config, "
+        "inputs and software are unchanged")
 
 
 def add_arguments(p):
     p.add_argument("config", type=Path, help="batch config: [batch] arcs = [run configs or globs], workers = N")
     p.add_argument("--scheduler", help="address of a running Dask scheduler (default: a local cluster)")
     p.add_argument("--workers", type=int, help="local cluster size (default: the config's, else 2)")
+    p.add_argument("--force", action="store_true", help="refit every arc, even unchanged ones")
 
 
 def _arc(path: Path) -> dict:
     return run_config(path, progress=None)
+
+
+def _arc_forced(path: Path) -> dict:
+    return run_config(path, force=True, progress=None)
 
 
 def run(args) -> int:
@@ -32,6 +38,7 @@ def run(args) -> int:
     arcs = sorted({p for pattern in batch["arcs"] for p in args.config.parent.glob(pattern)})
     if not arcs:
         raise ConfigError(args.config, "batch.arcs", "no run config matches")
-    outcomes = run_batch(arcs, _arc, scheduler=args.scheduler, workers=args.workers or batch.get("workers", 2))
+    outcomes = run_batch(arcs, _arc_forced if args.force else _arc, scheduler=args.scheduler,
+                         workers=args.workers or batch.get("workers", 2))
     print(night_summary(outcomes))
     return 1 if any(o.status == "failed" for o in outcomes) else 0

@@ -47,9 +47,27 @@ def versions() -> dict:
 
 
 def fingerprint(config_text: str, inputs) -> dict:
-    """What decides whether a run must be redone: the config's hash and each input's hash."""
+    """What decides whether a run must be redone: the config's hash, each input's hash and the software's."""
     return {"config_sha256": hashlib.sha256(config_text.encode()).hexdigest(),
-            "inputs": {str(Path(p)): sha256(p) for p in sorted(map(str, inputs))}}
+            "inputs": {str(Path(p)): sha256(p) for p in sorted(map(str, inputs))},
+            "software_sha256": software_sha256()}
+
+
+_SOFTWARE: dict = {}
+
+
+def software_sha256() -> str:
+    """Hash of the source of the packages that make the products (``odpipe`` and ``parsers``, every .py
+    and data file): a changed model reprocesses the arcs a nightly batch would otherwise skip."""
+    if "sha" not in _SOFTWARE:
+        h = hashlib.sha256()
+        for pkg in ("odpipe", "parsers"):
+            root = Path(__import__(pkg).__file__).resolve().parent
+            for f in sorted(p for p in root.rglob("*") if p.is_file() and p.suffix in (".py", ".csv", ".toml")):
+                h.update(str(f.relative_to(root.parent)).encode())
+                h.update(f.read_bytes())
+        _SOFTWARE["sha"] = h.hexdigest()
+    return _SOFTWARE["sha"]
 
 
 class Attempt:
@@ -110,7 +128,6 @@ def current_manifest(root) -> dict | None:
 
 
 def up_to_date(root, fingerprint_: dict) -> bool:
-    """True when the current attempt is complete and was made from the same config and inputs."""
+    """True when the current attempt is complete and was made from the same config, inputs and software."""
     m = current_manifest(root)
-    return (m is not None and m.get("config_sha256") == fingerprint_["config_sha256"]
-            and m.get("inputs") == fingerprint_["inputs"])
+    return m is not None and all(m.get(k) == v for k, v in fingerprint_.items())
