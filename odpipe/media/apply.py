@@ -5,7 +5,9 @@ reception, and (two- and three-way data) the uplink leg at the transmitting
 station at ``reception - round-trip light time``. Range rows get the summed
 group delays of their legs; Doppler rows (count-averaged) get the change of
 the summed phase delays over the count interval, end minus start — not the
-delay itself. Columns added:
+delay itself. Running Doppler counts (TRK-2-34 ``doppler_count_<mode>``, each
+row counting since the previous one) are Doppler rows of their mode: their
+changes add up to the change over any compressed window. Columns added:
 
 - ``tropo_m``, ``iono_m``, ``media_m`` (sum): m of path delay (range rows),
   m of delay change over the count interval (Doppler rows; the range-rate
@@ -55,7 +57,8 @@ def calibrate(table: pd.DataFrame, model: MediaModel, *, target_itrs=None, ramps
     if (out["pass_id"] < 0).all() and len(out):
         out = assign_passes(out)
     n = len(out)
-    obs = out["observable"].to_numpy(dtype=object)
+    # a running Doppler count is a Doppler row of its mode (its interval: since the previous count)
+    obs = np.char.replace(out["observable"].to_numpy(dtype=str), "doppler_count_", "doppler_").astype(object)
     ground = np.isin(obs, GROUND)
     doppler = np.char.startswith(obs.astype(str), "doppler")
     epoch = out["epoch"].to_numpy().astype("datetime64[ns]").view(np.int64)
