@@ -77,18 +77,54 @@ def build(n: int, **columns) -> pd.DataFrame:
     """A TrackingTable of ``n`` rows from arrays/scalars; unset columns get missing values.
 
     Format-specific extra columns may be passed too; they are kept after the
-    contract's columns. Columns are set one by one on an empty frame, which
-    spares pandas a consolidation copy of every column (large tables).
+    contract's columns. A str column may be given as a ``pd.Categorical`` (see
+    :func:`coded`): it is expanded by one take from its few labels instead of
+    converting ``n`` Python strings (several times faster for 10^6 rows), and
+    so is a scalar. The table holds copies of the arrays it is given.
     """
-    out = pd.DataFrame(index=pd.RangeIndex(n))
-    for name, (dt, _) in COLUMNS.items():
-        out[name] = _column(columns.pop(name, 0 if name == "flags" else _missing(dt)), dt, n)
+    return _build(n, columns, owned=False)
+
+
+def build_owned(n: int, **columns) -> pd.DataFrame:
+    """:func:`build` that takes over the arrays it is given instead of copying them (readers' fresh arrays).
+
+    The caller must not use those arrays afterwards. Views, read-only arrays and
+    an array given for two columns are still copied, so no column aliases
+    another or a file buffer. Saves one copy of every column (~0.4 s for
+    3.5 million rows and 30 columns).
+    """
+    return _build(n, columns, owned=True)
+
+
+def _build(n: int, columns: dict, owned: bool) -> pd.DataFrame:
+    given = {name: columns.get(name) for name in columns}
+    data = {name: _column(columns.pop(name, 0 if name == "flags" else _missing(dt)), dt, n)
+            for name, (dt, _) in COLUMNS.items()}
     for name, val in columns.items():
-        out[name] = np.broadcast_to(np.asarray(val), (n,)).copy() if np.ndim(val) == 0 else np.asarray(val)
-    return out
+        data[name] = np.broadcast_to(np.asarray(val), (n,)).copy() if np.ndim(val) == 0 else np.asarray(val)
+    seen: set[int] = set()
+    for name, arr in data.items():
+        if isinstance(arr, np.ndarray):
+            foreign = arr is given.get(name) and not owned
+            if foreign or id(arr) in seen or not (arr.flags.owndata and arr.flags.writeable):
+                data[name] = arr = arr.copy()
+            seen.add(id(arr))
+    return pd.DataFrame(data, index=pd.RangeIndex(n), copy=False)
 
 
-def _column(val, dt: str, n: int) -> np.ndarray:
+def coded(codes, labels) -> pd.Categorical:
+    """A str column given as integer ``codes`` into ``labels`` (labels may repeat), for :func:`build`."""
+    uniq, remap = np.unique(np.asarray(labels, dtype=object).astype(str), return_inverse=True)
+    return pd.Categorical.from_codes(remap.ravel()[np.asarray(codes)], uniq)
+
+
+def _column(val, dt: str, n: int):
+    if dt == "str" and isinstance(val, (str, pd.Categorical)):
+        cat = val if isinstance(val, pd.Categorical) else pd.Categorical.from_codes(np.zeros(n, np.int8), [val])
+        if len(cat) != n:
+            raise ValueError(f"column of {len(cat)} rows for a table of {n} rows")
+        labels = np.append(np.asarray(cat.categories, dtype=object), "")  # code -1 (missing) -> ""
+        return pd.array(labels, dtype="str").take(np.where(cat.codes < 0, len(labels) - 1, cat.codes))
     arr = np.asarray(val, dtype=_numpy_dtype(dt))
     if arr.ndim == 0:
         full = np.empty(n, dtype=arr.dtype)

@@ -45,7 +45,6 @@ import pandas as pd
 
 from parsers import table as tt
 from parsers.errors import ParseError, ParseReport, check_mode, handle
-from parsers.odf import code_labels
 from parsers.table import TrackingData
 
 RECORD = 75
@@ -188,6 +187,11 @@ def data_interval(tracker_and_interval: np.ndarray) -> np.ndarray:
 KINDS = ("range", "doppler", "angle1", "angle2")
 UNITS = np.array(["s", "Hz", "rad", "rad"], dtype=object)
 TAGS = np.array(["receive", "interval_end", "receive", "receive"], dtype=object)
+# observable labels: range, Doppler one-/two-way, then angle 1 and angle 2 by antenna geometry code 0-15
+OBSERVABLES = np.array(["range", "doppler_1way", "doppler_2way"]
+                       + [GEOMETRY.get(g, ("angle_1", "angle_2"))[a] for a in (0, 1) for g in range(16)], dtype=object)
+PADS = np.array([f"PAD-{c}" for c in range(256)] + [""], dtype=object)  # code 256: no station
+BAND_UP, BAND_DOWN = (np.array([BANDS.get(b, ("", ""))[i] for b in range(16)] + [""], dtype=object) for i in (0, 1))
 
 
 def _table(rec: pd.DataFrame, source: str) -> pd.DataFrame:
@@ -199,8 +203,6 @@ def _table(rec: pd.DataFrame, source: str) -> pd.DataFrame:
     tx_hz = col["transmit_freq_10hz"].astype(np.int64) * 10.0
     tracker = col["tracker_and_interval"].astype(np.int64)
     interval = data_interval(tracker)
-    up = np.array([BANDS.get(b, ("", ""))[0] for b in range(16)], dtype=object)[band]
-    down = np.array([BANDS.get(b, ("", ""))[1] for b in range(16)], dtype=object)[band]
     s_band = (band == 3) | (band == 8) | ((band == 0) & (tx_hz >= 2e9) & (tx_hz < 4e9))
     factor_m = np.where((band == 6) | (band == 8) | (tx_hz >= 12e9), 100.0, 1000.0)
     factor_k = np.where(s_band, 240 / 221, np.where(band == 1, 1.0, np.nan))
@@ -209,8 +211,6 @@ def _table(rec: pd.DataFrame, source: str) -> pd.DataFrame:
     a1, a2 = col["angle1"].astype(float), col["angle2"].astype(float)
     doppler_hz, count_time = _doppler(col, cnt, valid, interval, factor_m, epoch)
     geometry = (col["rx_antenna_type"] & 0x0F).astype(np.int64)
-    angle_names = [np.array([GEOMETRY.get(g, ("angle_1", "angle_2"))[k] for g in range(16)],
-                            dtype=object)[geometry] for k in (0, 1)]
     two_way = tx_hz > 0
 
     bits = np.stack([valid & 1, (valid >> 1) & 1, (valid >> 2) & 1, (valid >> 2) & 1], axis=1).astype(bool)
@@ -218,18 +218,18 @@ def _table(rec: pd.DataFrame, source: str) -> pd.DataFrame:
     value = np.stack([rng / 256e9, -doppler_hz, a1 / 2**32 * TWO_PI,
                       _signed_half_turn(a2 / 2**32 * TWO_PI)], axis=1)
     ctime = np.stack([np.zeros(n), count_time, np.zeros(n), np.zeros(n)], axis=1)
-    doppler_name = np.where(two_way, "doppler_2way", "doppler_1way").astype(object)
-    names = np.stack([np.full(n, "range", dtype=object), doppler_name, *angle_names], axis=1)
+    names = np.stack([np.zeros(n, np.int64), 1 + two_way, 3 + geometry, 19 + geometry], axis=1)  # OBSERVABLES
     flat = np.flatnonzero(present.ravel())
     flat = flat[np.argsort(epoch[flat // len(KINDS)], kind="stable")]  # time order, file order among equals
     r, k = flat // len(KINDS), flat % len(KINDS)
     is_doppler = k == 1
-    return tt.build(
-        len(r), epoch=epoch[r], tag=TAGS[k], observable=names.ravel()[flat], value=value.ravel()[flat],
-        unit=UNITS[k], count_time=ctime.ravel()[flat],
-        station_tx=np.where(two_way[r], _pads(col["tx_pad"][r]), "").astype(object),
-        station_rx=_pads(col["rx_pad"][r]), spacecraft=code_labels(col["sic"][r], str),
-        band_up=np.where(two_way[r], up[r], "").astype(object), band_down=down[r],
+    sics, sic_code = np.unique(col["sic"], return_inverse=True)
+    return tt.build_owned(
+        len(r), epoch=epoch[r], tag=tt.coded(k, TAGS), observable=tt.coded(names.ravel()[flat], OBSERVABLES),
+        value=value.ravel()[flat], unit=tt.coded(k, UNITS), count_time=ctime.ravel()[flat],
+        station_tx=tt.coded(np.where(two_way[r], col["tx_pad"][r], 256), PADS),
+        station_rx=tt.coded(col["rx_pad"][r], PADS), spacecraft=tt.coded(sic_code.ravel()[r], sics.astype(str)),
+        band_up=tt.coded(np.where(two_way[r], band[r], 16), BAND_UP), band_down=tt.coded(band[r], BAND_DOWN),
         uplink_hz=np.where(two_way[r], tx_hz[r], np.nan),
         transponder_ratio=np.where(two_way[r], factor_k[r], np.nan),
         source=source, record=rec.index.to_numpy()[r].astype(np.int64), flags=0,
@@ -277,7 +277,3 @@ def _signed_half_turn(angle: np.ndarray) -> np.ndarray:
     """Map [0, 2 pi) to [-pi, pi) (elevation and Y angles may be negative)."""
     return np.where(angle >= np.pi, angle - TWO_PI, angle)
 
-
-def _pads(pads: np.ndarray) -> np.ndarray:
-    """Station names from antenna pad ids: 'PAD-119'."""
-    return code_labels(pads, lambda c: f"PAD-{c}")

@@ -163,7 +163,7 @@ def tracking_table(blocks: list[Block], source: str) -> pd.DataFrame:
         columns[name] = np.concatenate([
             np.broadcast_to(np.asarray(p[name]), (n,)) if name in p else _missing_like(like, n)
             for p, n in zip(parts, sizes)])
-    df = tt.build(sum(sizes), source=source, flags=0, **columns)
+    df = tt.build_owned(sum(sizes), source=source, flags=0, **columns)
     return df.sort_values(["epoch", "record"], kind="stable").reset_index(drop=True)
 
 
