@@ -13,11 +13,26 @@ Rows per format code (``value`` in the format's own unit, named in ``unit``):
 - 16 carrier frequency observable: ``carrier_freq`` (Hz), one row per observation
 - 17 total count phase: ``total_phase`` (cycles), one row per observation
 
-Not checked against the SIS text (no copy here): the degree unit of angles, the RU unit
-of ranging phases and DRVID, and the sample timing below. Observation k of formats 16/17 is tagged at the SFDU time + k * obs_cnt_time. Formats
-9 (ramps) go to the ramp table; 10, 12, 13, 15 carry no navigation observable here and
-stay in the record blocks only. Every row keeps ``format_code`` and ``record`` (index of
-its SFDU in the file), so all of that SFDU's fields can be found in the blocks.
+Stations, mode and bands of SFDUs with a downlink follow :func:`_link` (validated fields
+first). Formats 9 (ramps) go to the ramp table (every ramp record starts a segment that
+ends where the station's next one starts, whatever its ``ramp_type``, which is kept);
+10, 12, 13, 15 carry no navigation observable here and stay in the record blocks only.
+Every row keeps ``format_code`` and ``record`` (index of its SFDU in the file), so all of
+that SFDU's fields can be found in the blocks.
+
+What these interpretations rest on (the SIS text itself is not available here): the byte
+layout of every field agrees with JPL's PyTrk234 (tests/test_trk234.py). Three independent
+converters agree with the rest: NASA's trk234-to-GMD script (phase = hi*2^32 + lo +
+frac*2^-32; total count phase at the SFDU time, consecutive SFDUs ``obs_cnt_time``
+apart), Tudat's TNF loader (observation 0 of format 16 at the SFDU time, count time
+``obs_cnt_time``; the link rules of :func:`_link`) and CU Boulder's scarabaeus (range in
+RU, RU per second = 16 * exc_scalar_num / exc_scalar_den * uplink Hz, quoting TRK-2-34
+Rev N note 39). Assumed, not confirmed by any source: observation k of one format 16/17
+SFDU at the SFDU time + k * obs_cnt_time; the degree unit of angles; the RU unit of
+ranging phases and DRVID; ``range`` = ``rng_obs`` (format 7) and ``rng_obs_dl``
+(format 14), where those converters instead take ``meas_rng`` and apply the station
+calibrations and Z-height corrections themselves; and every ramp record starting a
+segment, where Tudat keeps only ramp types 1 (start) and 4/5 (end).
 """
 
 from __future__ import annotations
@@ -61,20 +76,44 @@ def _band(codes) -> np.ndarray:
 _DOPPLER = {1: "1way", 2: "2way", 3: "3way"}
 
 
+def doppler_mode(r: np.ndarray) -> np.ndarray:
+    """Doppler mode (1, 2, 3 way; 0 none, 4 invalid): the validated ``vld_dop_mode``, else ``prdx_mode``."""
+    return np.where(r["vld_dop_mode"] != 0, r["vld_dop_mode"], r["prdx_mode"]).astype(np.int64)
+
+
+def _link(r: np.ndarray, station_rx: np.ndarray) -> dict:
+    """Transmitting station and uplink band of SFDUs with a downlink (C124, C125, C127).
+
+    The validated fields win over the predicted ones (``vld_ul_stn`` over the
+    receiver for 2-way and ``ul_prdx_stn`` for 3-way; ``vld_dop_mode`` over
+    ``prdx_mode``), as Tudat's TNF loader reads them; the uplink band is
+    ``ul_band_dl`` (the uplink band the downlink channel reports), else
+    ``ul_band``. One-way rows (and modes none or invalid) have no transmitter
+    and no uplink band.
+    """
+    mode = doppler_mode(r)
+    predicted = np.where(mode == 2, station_rx, np.where(mode == 3, _dss(r["ul_prdx_stn"]), ""))
+    tx = np.where(r["vld_ul_stn"] != 0, _dss(r["vld_ul_stn"]), predicted)
+    band = r["ul_band_dl"]
+    if "ul_band" in r.dtype.names:
+        band = np.where(band != 0, band, r["ul_band"])
+    no_uplink = (mode == 1) | (mode == 0) | (mode == 4)
+    return {"station_tx": np.where(no_uplink, "", tx).astype(object),
+            "band_up": np.where(no_uplink, "", _band(band)).astype(object)}
+
+
 def _common(r: np.ndarray, fc: int) -> dict:
     """Columns every format shares: time tag, spacecraft, stations and bands from the secondary CHDO."""
     names = r.dtype.names
     cols = {"epoch": utc(r["year"], r["doy"], r["sec"]), "spacecraft": _NUMBER[r["scft_id"]]}
     if "ul_dss_id" in names:
         cols["station_tx"] = _dss(r["ul_dss_id"])
-    if "dl_dss_id" in names:
-        cols["station_rx"] = _dss(r["dl_dss_id"])
-        if "ul_prdx_stn" in names:
-            mode = r["prdx_mode"]
-            cols["station_tx"] = np.where(mode == 2, cols["station_rx"],
-                                          np.where(mode == 3, _dss(r["ul_prdx_stn"]), "")).astype(object)
     if "ul_band" in names:
         cols["band_up"] = _band(r["ul_band"])
+    if "dl_dss_id" in names:
+        cols["station_rx"] = _dss(r["dl_dss_id"])
+    if "vld_dop_mode" in names:  # downlink, derived and filtered SFDUs
+        cols.update(_link(r, cols["station_rx"]))
     if "vld_dl_band" in names:
         cols["band_down"] = _band(r["vld_dl_band"])
     elif "dl_band" in names:
@@ -117,7 +156,7 @@ def _rows(block: Block) -> list[dict]:
             extra["uplink_hz"] = r["ul_freq"] if fc == 7 else np.nan
         return [dict(base, observable=name, value=np.asarray(value(), np.float64), unit=unit, **extra)]
     if fc == 6:
-        mode = np.array([_DOPPLER.get(int(m), "unknown") for m in range(256)], dtype=object)[r["prdx_mode"]]
+        mode = np.array([_DOPPLER.get(m, "unknown") for m in range(256)], dtype=object)[doppler_mode(r)]
         # the count accumulates up to the time tag; count_time is the time since the previous count
         return [dict(base, observable=np.char.add("doppler_count_", mode.astype(str)).astype(object),
                      value=r["dop_cnt"].astype(np.float64), unit="cycles", uplink_hz=r["ul_freq"],
