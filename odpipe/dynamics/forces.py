@@ -10,13 +10,15 @@ A :class:`ForceModel` is a centre (NAIF name: 'earth', 'moon', 'sun', 'emb',
   point-mass indirect term);
 * :class:`SolarRadiationPressure` - cannonball Cr*A and/or :class:`Plate` and
   :class:`Cylinder` surfaces, conical shadow of the occulting bodies;
+* :class:`AtmosphericDrag` - Harris-Priester drag, atmosphere co-rotating with the Earth
+  (Earth-centred models only, :mod:`odpipe.dynamics.drag`);
 * :class:`EmpiricalRTN` - constant or piecewise-constant RTN accelerations;
 * :class:`Relativity` - Schwarzschild term of the central body;
 * :class:`FiniteBurn` - constant thrust in ICRF or RTN over an interval, with mass flow;
 * :class:`ImpulsiveManeuver` - ICRF delta-v at an epoch (handled by the propagator).
 
 Estimable dynamic parameters (names used by ``Trajectory.param_names``):
-``srp_scale``, ``rho_s[k]``/``rho_d[k]`` (surface k), ``emp[b].R|T|N`` (batch b),
+``srp_scale``, ``rho_s[k]``/``rho_d[k]`` (surface k), ``cd`` (drag), ``emp[b].R|T|N`` (batch b),
 ``dv[k].x|y|z`` and ``dv[k].t`` (impulsive maneuver k).
 """
 
@@ -83,6 +85,15 @@ class SolarRadiationPressure:
 
 
 @dataclass
+class AtmosphericDrag:
+    """Drag coefficient Cd, cross-section area (m^2); Harris-Priester bulge exponent n (2 low, 6 polar orbits)."""
+
+    cd: float
+    area: float
+    n_bulge: float = 6.0
+
+
+@dataclass
 class EmpiricalRTN:
     """Rows (t_start, t_end, aR, aT, aN): TDB s, m/s^2; active for t_start <= t < t_end."""
 
@@ -134,6 +145,8 @@ class ForceModel:
             names.append("srp_scale")
             for k in range(len(srp.surfaces)):
                 names += [f"rho_s[{k}]", f"rho_d[{k}]"]
+        if self.of_type(AtmosphericDrag):
+            names.append("cd")
         for emp in self.of_type(EmpiricalRTN):
             for b in range(len(np.atleast_2d(emp.batches))):
                 names += [f"emp[{b}].{c}" for c in "RTN"]
@@ -151,12 +164,14 @@ class ForceModel:
         return sorted(set(pts))
 
 
-PARAM_SCALE, PARAM_RHO_S, PARAM_RHO_D, PARAM_EMP, PARAM_DV, PARAM_DT = range(6)
+PARAM_SCALE, PARAM_RHO_S, PARAM_RHO_D, PARAM_EMP, PARAM_DV, PARAM_DT, PARAM_CD = range(7)
 
 
 def _param_code(name: str) -> tuple[int, int]:
     if name == "srp_scale":
         return PARAM_SCALE, 0
+    if name == "cd":
+        return PARAM_CD, 0
     head, _, tail = name.partition("]")
     kind, _, idx = head.partition("[")
     idx = int(idx)
@@ -188,6 +203,7 @@ def compile_model(fm: ForceModel, t0: float, t1: float, params: Sequence[str], w
 
     ``model[1][5]`` is the mid-epoch of the segment being integrated; the propagator
     sets it so empirical batches and burns switch exactly at segment boundaries.
+    ``model[16]`` is the drag row [on, Cd, area (m^2), bulge exponent, Sun slot].
     """
     lo, hi = min(t0, t1) - 3600.0, max(t0, t1) + 3600.0
     eph = fm.ephemeris
@@ -197,11 +213,15 @@ def compile_model(fm: ForceModel, t0: float, t1: float, params: Sequence[str], w
     srp = fm.of_type(SolarRadiationPressure)
     srp = srp[0] if srp else None
     third = [b.lower() for pm in fm.of_type(PointMasses) for b in pm.bodies]
+    drag = fm.of_type(AtmosphericDrag)
+    drag = drag[0] if drag else None
+    if drag is not None and center != "earth":
+        raise ValueError("atmospheric drag needs an Earth-centred force model")
     # every body whose position the kernel needs, relative to the centre
     needed = list(dict.fromkeys(
         third + [s.body.lower() for s in sh_list if s.body.lower() != center]
         + ([b.lower() for b in srp.occulters if b.lower() != center] if srp else [])
-        + (["sun"] if srp and center != "sun" else [])))
+        + (["sun"] if (srp or drag) and center != "sun" else [])))
     if needed:
         interp = eph.interpolant(needed, center, lo, hi)
         coeffs, t_start, t_step = interp.coeffs, interp.t_start, interp.t_step
@@ -260,5 +280,7 @@ def compile_model(fm: ForceModel, t0: float, t1: float, params: Sequence[str], w
     pmap = np.array([_param_code(p) for p in params], dtype=np.int64).reshape(-1, 2)
     flags = np.array([1 if fm.of_type(Relativity) else 0, 1 if with_stm else 0, sun_slot], dtype=np.int64)
     scal = np.array([gm_center, fm.mass, t_start, t_step, gm_body, 0.5 * (t0 + t1)])
+    drag_row = (np.array([1.0, drag.cd, drag.area, drag.n_bulge, slot["sun"]]) if drag is not None
+                else np.zeros(5))
     return (flags, scal, coeffs, pm, C, S, fac, sh_meta, rot_coefs, rot_meta, srp_row, surfaces, occ,
-            emp, burns, pmap)
+            emp, burns, pmap, drag_row)

@@ -14,7 +14,8 @@ from numba.extending import overload
 
 from odpipe.dynamics.chebyshev import evaluate
 from odpipe.dynamics.dop853 import derivative
-from odpipe.dynamics.forces import PARAM_EMP, PARAM_RHO_D, PARAM_RHO_S, PARAM_SCALE
+from odpipe.dynamics.drag import drag_acceleration
+from odpipe.dynamics.forces import PARAM_CD, PARAM_EMP, PARAM_RHO_D, PARAM_RHO_S, PARAM_SCALE
 from odpipe.dynamics.harmonics import sh_acceleration
 from odpipe.dynamics.pointmass import central, third_body
 from odpipe.dynamics.relativity import schwarzschild
@@ -36,7 +37,7 @@ def spacecraft_mass(t, mass0, burns):
 def acceleration(t, r, v, model, acc, grad_r, grad_v, dadp):
     """Total acceleration (m/s^2), its partials wrt r, v and the parameters (p, 3)."""
     (flags, scal, coeffs, pm, C, S, fac, sh_meta, rot_coefs, rot_meta, srp_row, surfaces, occ,
-     emp, burns, pmap) = model
+     emp, burns, pmap, drag) = model
     with_stm = flags[1] == 1
     pos = interp_positions(coeffs, scal[2], scal[3], t)
     if scal[0] > 0.0:
@@ -85,6 +86,12 @@ def acceleration(t, r, v, model, acc, grad_r, grad_v, dadp):
                 dadp[p] += d_rs[idx]
             elif kind == PARAM_RHO_D:
                 dadp[p] += d_rd[idx]
+    if drag[0] > 0.0:
+        d_cd = np.zeros(3)
+        drag_acceleration(r, v, pos[int(drag[4])], drag[1], drag[2], mass, drag[3], acc, grad_r, grad_v, d_cd)
+        for p in range(pmap.shape[0]):
+            if pmap[p, 0] == PARAM_CD:
+                dadp[p] += d_cd
     t_seg = scal[5]  # mid-epoch of the segment: piecewise-constant terms switch only between segments
     for b in range(emp.shape[0]):
         if emp[b, 0] <= t_seg < emp[b, 1]:
