@@ -111,7 +111,7 @@ def test_reduced_run_dowr_clock_and_mode_ordering(shared_data, tmp_path):
     one-way ranging (the Simu. 8 link plan): Table 13's ordering (one-way 7x worse on the clock and
     20-240x on the DRO position), the LEO converging first (Simu. 6: 2 days), the clock below 100 ns
     (sec. 5.4.3). (Table 13's 40-day figures themselves need the full run: runs/liaison_dowr.toml.)"""
-    cfg = dict(CFG, arc_days=3.0, last_days=1.0, stage_days=[1.0], max_iter=2,
+    cfg = dict(CFG, arc_days=3.0, last_days=1.0, stage_days=[0.5], max_iter=4, final_iter=2,
                earth_gravity=str(shared_data / "gravity/tudat/ggm02c.txt"),
                moon_gravity=str(shared_data / "gravity/gmat/LP165P.cof"))
     cfg["model"] = dict(CFG["model"], truth=dict(CFG["model"]["truth"], earth_degree={"DRO": 4, "LEO": 20},
