@@ -4,6 +4,7 @@ import json
 from pathlib import Path
 
 import numpy as np
+import pandas as pd
 import pytest
 
 from heo_case import simulate, write_config
@@ -56,3 +57,33 @@ def test_unchanged_arc_is_skipped_and_failed_rerun_keeps_products(case):
     finally:
         bad.write_text(text)
     assert (Path(out["run"]) / "manifest.json").read_text() == before
+
+
+def test_next_arc_starts_from_this_arcs_oem(case):
+    """A nightly chain: the a priori of the next arc is this arc's OEM state; batch runs this arc first."""
+    from odpipe.commands.batch import starts_from
+    from odpipe.pipeline.config import load_config
+    from odpipe.pipeline.setup import initial_state, tdb
+    from odpipe.time import tdb_to_utc
+
+    tmp, out, truth = case
+    seg = oem.read(Path(out["run"]) / "trajectory.oem")[0]
+    assert seg.meta["TIME_SYSTEM"] == "TDB"
+    k = np.searchsorted(seg.epochs, np.datetime64("2003-06-04T00:00:00", "ns"))
+    t_node = (seg.epochs[k] - np.datetime64("2000-01-01T12:00:00", "ns")) / np.timedelta64(1, "s")
+    start2 = str(tdb_to_utc(np.array([t_node]))[0])  # an OEM node: read there without interpolation
+    text = (tmp / "arc.toml").read_text().replace('name = "sim_arc"', 'name = "sim_arc_next"')
+    text = text.replace(f'start = "{START}"', f'start = "{start2}"')
+    head, _, tail = text.partition("[initial_state]")
+    tail = tail.split("[estimation]", 1)[1]
+    (tmp / "next.toml").write_text(head + f'[initial_state]\nepoch = "{start2}"\n'
+                                   'from_oem = "out/sim_arc/current/trajectory.oem"\n[estimation]' + tail)
+    cfg = load_config(tmp / "next.toml")
+    np.testing.assert_allclose(initial_state(cfg, tdb(start2)), seg.states[k], rtol=0, atol=1e-4)
+    assert starts_from([tmp / "arc.toml", tmp / "next.toml"]) == {tmp / "next.toml": [tmp / "arc.toml"]}
+    nxt = run_config(tmp / "next.toml", progress=None)
+    assert nxt["status"] == "complete" and nxt["converged"]
+    par = pd.read_csv(Path(nxt["run"]) / "parameters.csv")
+    state = par[par["kind"] == "state"]
+    err = state["estimate"].to_numpy() - truth.state(np.array([tdb(start2)]))[0]
+    assert np.all(np.abs(err) < 3 * state["sigma"].to_numpy()), (err, state["sigma"].to_numpy())

@@ -13,7 +13,7 @@ import pandas as pd
 import pytest
 
 from odpipe.runs import rundir
-from odpipe.runs.batch import night_summary, run_batch
+from odpipe.runs.batch import dependency_order, night_summary, run_batch
 from odpipe.runs.report import Section, write_report
 from odpipe.runs.schema import ConfigError, load
 
@@ -118,6 +118,22 @@ def test_one_failing_arc_does_not_stop_the_batch(tmp_path, monkeypatch):
     assert "1 failed" in night_summary(list(out.values()))
     again = run_batch(configs, run_arc, workers=2, progress=lambda s: None)
     assert sorted(o.status for o in again) == ["failed", "skipped", "skipped"]
+
+
+def test_chained_arcs_run_after_their_source_and_not_after_a_failure(tmp_path, monkeypatch):
+    monkeypatch.setenv("PYTHONPATH", str(ROOT))
+    from tests.batch_job import run_arc
+    c = _arcs(tmp_path, 4, 0.5, fail={0})
+    after = {c[1]: [c[0]], c[2]: [c[3]]}   # arc1 starts from the failing arc0, arc2 from arc3
+    outcomes = run_batch([c[2], c[1], c[0], c[3]], run_arc, after=after, workers=2, progress=lambda s: None)
+    order = [Path(o.config).stem for o in outcomes]
+    out = {Path(o.config).stem: o for o in outcomes}
+    assert out["arc0"].status == "failed" and out["arc1"].status == "failed"
+    assert "not run: it starts from arc0.toml, which failed" in out["arc1"].error
+    assert not (tmp_path / "out" / "arc1").exists()
+    assert out["arc2"].status == "complete" and order.index("arc3") < order.index("arc2")
+    with pytest.raises(ValueError, match="cycle"):
+        dependency_order(["a", "b"], {"a": ["b"], "b": ["a"]})
 
 
 def test_batch_killed_midway_resumes_without_redoing_arcs(tmp_path, monkeypatch):

@@ -20,6 +20,10 @@ from odpipe.dynamics.rhs import acceleration  # also registers the orbit right-h
 from odpipe.dynamics.trajectory import Trajectory, TrajectorySet
 
 
+class IntegrationError(RuntimeError):
+    """The integrator gave up (typically a trajectory driven into the central body)."""
+
+
 def _state_derivative(t, r, v, model):
     acc = np.zeros(3)
     acceleration(t, r, v, model, acc, np.zeros((3, 3)), np.zeros((3, 3)),
@@ -57,7 +61,11 @@ def propagate(state0, t0: float, t1: float, force_model: ForceModel, with_stm: b
     t_a = t0
     for t_b in cuts + [t1]:
         model[1][5] = 0.5 * (t_a + t_b)
-        ts, ys, Fs, ne = integrate(model, float(t_a), y, float(t_b), rtol, atol, max_step, 6)
+        try:
+            ts, ys, Fs, ne = integrate(model, float(t_a), y, float(t_b), rtol, atol, max_step, 6)
+        except RuntimeError as err:
+            raise IntegrationError(f"{err} between TDB {t_a:.3f} and {t_b:.3f} s, starting "
+                                   f"{np.linalg.norm(y[:3]) / 1e3:.3f} km from {force_model.center}") from err
         pieces.append((ts, ys, Fs))
         n_eval += ne
         y = ys[-1].copy()

@@ -67,8 +67,13 @@ class FitOptions:
     iteration (last value repeats; inf = off), applied only once the previous
     post-fit RMS (whitened) is below edit_gate_rms, so that a far-off first
     reference does not reject good data; reweight: scale each group's sigma by
-    its post-fit RMS; tol_dx: converged when every epoch correction < tol_dx sigma and
-    the post-fit RMS changed by < tol_rms (relative); extra_epochs: more grid epochs
+    its post-fit RMS; sigma_scale: data-weight stages, each multiplying every sigma (e.g.
+    (30, 5, 1)): a far-off reference is first fitted with loose weights, and the next
+    stage starts once the epoch correction is below stage_tol sigma, so the tight fit
+    starts inside its linear regime (the first pass of a stage edits nothing); max_halvings: when the models cannot be evaluated
+    about a corrected reference (e.g. an orbit driven into the central body), the correction
+    is halved up to this many times before FitDiverged; tol_dx: converged (at the last stage) when every
+    epoch correction < tol_dx sigma and the post-fit RMS changed by < tol_rms (relative); extra_epochs: more grid epochs
     (TDB s); output_at_measurements: put every observation time on the grid, so
     filtered and smoothed estimates exist at each measurement time."""
 
@@ -77,6 +82,9 @@ class FitOptions:
     edit_k: tuple = (np.inf, 10.0, 5.0)
     edit_gate_rms: float = 3.0
     reweight: bool = False
+    sigma_scale: tuple = (1.0,)
+    stage_tol: float = 1.0
+    max_halvings: int = 6
     tol_dx: float = 1e-2
     tol_rms: float = 1e-3
     extra_epochs: tuple = ()
@@ -105,6 +113,10 @@ def _edit_k(options, it, prev_rms):
     if prev_rms is not None and prev_rms > options.edit_gate_rms:
         return np.inf
     return options.edit_k[min(it, len(options.edit_k) - 1)]
+
+
+class FitDiverged(RuntimeError):
+    """The iterations drove the reference where the models cannot be evaluated."""
 
 
 @dataclass
@@ -188,11 +200,25 @@ def fit(problem: Problem, obs: Observations, t_start: float, t_end: float,
     scale = {g: 1.0 for g in groups}
     p_after = {}           # (grid index, group) -> reference stochastic values after the step
     history, prev_rms, converged = [], None, False
+    stage, last_stage = 0, len(options.sigma_scale) - 1
+    last_step, halvings, stage_start = None, 0, False
     for it in range(options.max_iter):
-        sig_row = obs.sigma * np.array([scale[g] for g in obs.group])
-        kk = _edit_k(options, it, prev_rms)
-        ps = _filter_smoother_pass(problem, obs, grid, steps, bounds, x_ref0, p_after,
-                                   sig_row, kk)
+        sig_row = obs.sigma * np.array([scale[g] for g in obs.group]) * options.sigma_scale[stage]
+        kk = np.inf if stage_start else _edit_k(options, it, prev_rms)  # a new stage's first pass edits nothing
+        stage_start = False
+        for halving in range(options.max_halvings + 1):
+            try:
+                ps = _filter_smoother_pass(problem, obs, grid, steps, bounds, x_ref0, p_after, sig_row, kk)
+                break
+            except (RuntimeError, ValueError) as err:  # e.g. an orbit driven into the body, light time off its span
+                if last_step is None or halving == options.max_halvings:
+                    raise FitDiverged(f"iteration {it + 1}: the reference cannot be integrated ({err})") from err
+                step_x, step_p = last_step
+                last_step = (0.5 * step_x, {key: 0.5 * v for key, v in step_p.items()})
+                x_ref0 = x_ref0 - last_step[0]
+                for key, v in last_step[1].items():
+                    p_after[key] -= v
+                halvings += 1
         needed = {0} | {b[0] for b in ps.blocks} | set(steps)
         dx = {k: _estimate(ps, *ps.smoothed[k]) for k in needed}
         postfit = np.full(obs.time.size, np.nan)
@@ -206,20 +232,31 @@ def fit(problem: Problem, obs: Observations, t_start: float, t_end: float,
                         "prefit_rms": float(np.sqrt(np.mean((ps.prefit[ok] / sig_row[ok]) ** 2))),
                         "edited": int(np.sum(ps.flags & EDIT_INNOVATION > 0)),
                         "max_correction_sigma": float(corr), "edit_k": float(kk),
+                        "sigma_scale": float(options.sigma_scale[stage]),
+                        "halvings": halvings,
                         "scales": {str(g): float(v) for g, v in scale.items()}})
         # relinearize about the smoothed solution
-        x_ref0 = x_ref0.copy()
-        x_ref0[:n_est] += dx[0][:n_est]
+        step_x = np.zeros_like(x_ref0)
+        step_x[:n_est] = dx[0][:n_est]
+        x_ref0 = x_ref0 + step_x
+        step_p = {}
         for k in steps:
             for j, (idx, _) in enumerate(steps[k]):
+                step_p[(k, j)] = dx[k][idx]
                 p_after[(k, j)] = ps.refs[k][idx] + dx[k][idx]
+        last_step, halvings = (step_x, step_p), 0
         rms_ok = prev_rms is not None and abs(rms - prev_rms) <= options.tol_rms * prev_rms
         prev_rms = rms
-        if options.reweight:
+        if options.reweight and stage == last_stage:
             for g in groups:
                 sel = ok & (obs.group == g)
                 if sel.sum() >= 10:
                     scale[g] *= float(np.sqrt(np.mean((postfit[sel] / sig_row[sel]) ** 2)))
+        if stage < last_stage:
+            if corr < options.stage_tol:
+                prev_rms *= options.sigma_scale[stage] / options.sigma_scale[stage + 1]  # in the next stage's units
+                stage, stage_start = stage + 1, True
+            continue
         if corr < options.tol_dx and rms_ok and it >= 1:
             converged = True
             break

@@ -59,6 +59,7 @@ class ArcSetup:
     station_sigma: considered (not estimated) error of each station's ITRS coordinates (m per axis).
     media_sigma: considered error of the media calibration scale (fraction of ``media_m``).
     edit_k: innovation k-sigma per iteration (last repeats); reweight: ARTEMIS data reweighting.
+    sigma_scale: data-weight stages (loose to tight; see :class:`FitOptions`).
     block: filter grid spacing (s); lookback: s of trajectory kept before each segment start.
     tabulate_earth_rotation: evaluate the GCRS->ITRS matrix from a per-arc Chebyshev table
     (:mod:`.rotation`, < 1e-12 rad) instead of the full model at every event.
@@ -83,6 +84,7 @@ class ArcSetup:
     edit_k: tuple = (np.inf, 10.0, 5.0)
     max_iter: int = 10
     reweight: bool = False
+    sigma_scale: tuple = (1.0,)
     block: float = 600.0
     lookback: float = 120.0
     growing_days: float | None = 2.0  # first span of the growing-arc start (None: fit the whole arc at once)
@@ -185,7 +187,7 @@ def fit_arc(table: pd.DataFrame, setup: ArcSetup) -> ArcSolution:
     rows, times = select_rows(table, setup)
     reg = build_registry(setup, rows)
     options = FitOptions(max_iter=setup.max_iter, block=setup.block, edit_k=tuple(setup.edit_k),
-                         reweight=setup.reweight)
+                         reweight=setup.reweight, sigma_scale=tuple(setup.sigma_scale))
     grid, _ = build_grid(reg, setup.start, setup.end, options.block, options.extra_epochs)
 
     meas = setup.measurements

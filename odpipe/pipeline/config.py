@@ -92,8 +92,13 @@ class DynamicsSection:
 
 @dataclass
 class InitialStateSection:
+    """The a priori state at ``epoch``: given (``state``) or read from an OEM (``from_oem``), e.g. the
+    previous arc's ``OUTPUT/NAME/current/trajectory.oem`` (a nightly chain; ``odpipe batch`` runs
+    that arc first)."""
+
     epoch: str  # UTC
-    state: list[float]  # m, m/s, ICRF axes about dynamics.center
+    state: list[float] | None = None  # m, m/s, ICRF axes about dynamics.center
+    from_oem: Path | None = None
 
 
 @dataclass
@@ -117,6 +122,9 @@ class EstimationSection:
     edit_k: list[float] = field(default_factory=lambda: [float("inf"), 10.0, 5.0])
     max_iter: int = 10
     reweight: bool = False  # ARTEMIS reweighting from post-fit RMS; see README (known instability)
+    # data-weight stages multiplying every sigma, loose to tight (e.g. [30, 5, 1]): the next stage starts once
+    # the epoch correction is below 1 sigma, so a far-off a priori is not fitted at full weight at once
+    sigma_scale: list[float] = field(default_factory=lambda: [1.0])
     block: float = 600.0
     # unlogged maneuvers: the filter's innovations are always tested (findings in the report); with a sigma
     # (m/s per axis) each finding also becomes an estimated impulsive maneuver and the arc is fitted again
@@ -160,7 +168,10 @@ def load_config(path) -> RunConfig:
         if reserved in data:
             raise ConfigError(path, reserved, "unknown key")
     cfg = load(RunConfig, data, path)
-    if len(cfg.initial_state.state) != 6:
+    init = cfg.initial_state
+    if (init.state is None) == (init.from_oem is None):
+        raise ConfigError(path, "initial_state", "give either state or from_oem")
+    if init.state is not None and len(init.state) != 6:
         raise ConfigError(path, "initial_state.state", "needs 6 numbers (m, m/s)")
     cfg.path, cfg.text = path, text
     return cfg

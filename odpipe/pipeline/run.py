@@ -37,6 +37,7 @@ from odpipe.products.atomic import write_text
 from odpipe.products.oem import write_oem
 from odpipe.products.spk import write_spk
 from odpipe.runs import rundir
+from odpipe.runs.schema import ConfigError
 from odpipe.runs.report import Section, write_report
 from odpipe.time import tdb_to_utc
 from parsers.ionex import read_ionex
@@ -60,6 +61,9 @@ def run_config(path, *, force: bool = False, progress=print) -> dict:
     """Run the arc of config ``path``; returns ``{"status": "complete" | "skipped", "run": folder, ...}``."""
     cfg = load_config(path)
     root = cfg.run.output / cfg.run.name
+    source = cfg.initial_state.from_oem
+    if source is not None and not source.exists():
+        raise ConfigError(cfg.path, "initial_state.from_oem", f"{source} does not exist (run its arc first)")
     fingerprint = rundir.fingerprint(cfg.text, build.input_files(cfg))
     if not force and rundir.up_to_date(root, fingerprint):
         if progress:

@@ -7,6 +7,7 @@ import pandas as pd
 
 from odpipe.dynamics import forces as F
 from odpipe.dynamics.propagator import propagate
+from odpipe.analysis.overlap import oem_trajectory
 from odpipe.environment.ephemeris import Ephemeris
 from odpipe.environment.gravity import read_gravity
 from odpipe.environment.stations import StationCatalog
@@ -16,6 +17,7 @@ from odpipe.frames.local import rtn_matrix
 from odpipe.measurements import MeasurementSetup
 from odpipe.od.arc import ArcSetup, ManeuverPlan
 from odpipe.pipeline.config import RunConfig
+from odpipe.runs.schema import ConfigError
 from odpipe.time import utc_to_tdb
 from parsers.maneuvers import read_plan
 
@@ -90,11 +92,26 @@ def station_catalog(cfg: RunConfig) -> StationCatalog:
     return catalog
 
 
+def initial_state(cfg: RunConfig, t_tdb: float) -> np.ndarray:
+    """The configured a priori state (m, m/s, ICRF about the dynamics centre) at ``t_tdb``."""
+    init = cfg.initial_state
+    if init.from_oem is None:
+        return np.asarray(init.state, float)
+    traj = oem_trajectory(init.from_oem)
+    if traj.center != cfg.dynamics.center.lower():
+        raise ConfigError(cfg.path, "initial_state.from_oem",
+                          f"{init.from_oem} is about {traj.center}, the dynamics about {cfg.dynamics.center}")
+    try:
+        return traj.state(t_tdb)[0]
+    except ValueError as err:
+        raise ConfigError(cfg.path, "initial_state.epoch", f"{init.epoch} is not covered by {init.from_oem}: {err}")
+
+
 def arc_setup(cfg: RunConfig, fm: F.ForceModel, ramps, catalog: StationCatalog) -> ArcSetup:
     est = cfg.estimation
     start, end = tdb(cfg.arc.start), tdb(cfg.arc.end)
     t_state = tdb(cfg.initial_state.epoch)
-    state0 = np.asarray(cfg.initial_state.state, float)
+    state0 = initial_state(cfg, t_state)
     if abs(t_state - start) > 1e-6:  # move the a priori state to the arc start
         state0 = propagate(state0, t_state, start, fm, with_stm=False).state(start)[0]
     meas = MeasurementSetup(fm.ephemeris, catalog, ramps=ramps, gcrs_to_itrs=gcrs_to_itrs)
@@ -105,7 +122,8 @@ def arc_setup(cfg: RunConfig, fm: F.ForceModel, ramps, catalog: StationCatalog) 
                     srp_scale_sigma=est.srp_scale_sigma if cfg.dynamics.srp is not None else None,
                     stochastic=stochastic, maneuvers=tuple(maneuver_plans(cfg, fm, state0, start)),
                     data_sigma=dict(est.data_sigma), range_bias_sigma=est.range_bias_sigma,
-                    edit_k=tuple(est.edit_k), max_iter=est.max_iter, reweight=est.reweight, block=est.block)
+                    edit_k=tuple(est.edit_k), max_iter=est.max_iter, reweight=est.reweight,
+                    sigma_scale=tuple(est.sigma_scale), block=est.block)
 
 
 def a_priori_trajectory(setup: ArcSetup):
@@ -122,4 +140,6 @@ def input_files(cfg: RunConfig) -> list:
     files += [g.file for g in cfg.dynamics.gravity]
     if cfg.estimation.maneuver_plan is not None:
         files.append(cfg.estimation.maneuver_plan)
+    if cfg.initial_state.from_oem is not None:
+        files.append(cfg.initial_state.from_oem)
     return files

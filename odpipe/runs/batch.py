@@ -4,7 +4,9 @@ Each arc is a run configuration; ``run_one(config_path) -> dict`` runs it and
 returns at least ``{"status": "complete" | "skipped", ...}``. An arc whose
 products are complete and whose config and inputs are unchanged is skipped
 by ``run_one`` itself (see :func:`odpipe.runs.rundir.up_to_date`), so a
-batch killed at any point is simply started again.
+batch killed at any point is simply started again. An arc that starts from another
+arc's products (a nightly chain) runs after it, and is reported failed without being
+run when that arc failed.
 """
 
 from __future__ import annotations
@@ -25,7 +27,10 @@ class ArcOutcome:
     error: str = ""
 
 
-def _guarded(run_one: Callable[[Path], dict], config: str) -> ArcOutcome:
+def _guarded(run_one: Callable[[Path], dict], config: str, *after: ArcOutcome) -> ArcOutcome:
+    failed = [Path(o.config).name for o in after if o.status == "failed"]
+    if failed:
+        return ArcOutcome(config, "failed", 0.0, error=f"not run: it starts from {', '.join(failed)}, which failed")
     t0 = time.perf_counter()
     try:
         detail = run_one(Path(config)) or {}
@@ -35,21 +40,47 @@ def _guarded(run_one: Callable[[Path], dict], config: str) -> ArcOutcome:
                           error="".join(traceback.format_exception_only(exc)).strip())
 
 
-def run_batch(configs, run_one: Callable[[Path], dict], *, scheduler: str | None = None, workers: int = 2,
-              progress: Callable[[str], None] = print) -> list[ArcOutcome]:
+def dependency_order(configs: list[str], after: dict) -> list[str]:
+    """``configs`` ordered so that every arc comes after those it starts from (``after[c]``)."""
+    order, state = [], {}
+
+    def visit(c, chain):
+        if state.get(c) == "done":
+            return
+        if state.get(c) == "open":
+            raise ValueError(f"arcs start from each other in a cycle: {' -> '.join(map(str, chain + [c]))}")
+        state[c] = "open"
+        for d in after.get(c, ()):
+            visit(d, chain + [c])
+        state[c] = "done"
+        order.append(c)
+
+    for c in configs:
+        visit(c, [])
+    return order
+
+
+def run_batch(configs, run_one: Callable[[Path], dict], *, after: dict | None = None, scheduler: str | None = None,
+              workers: int = 2, progress: Callable[[str], None] = print) -> list[ArcOutcome]:
     """Run every arc config; returns one outcome per arc in completion order.
 
-    ``scheduler`` is the address of a running Dask scheduler; without it a
-    local cluster of ``workers`` single-threaded processes is started.
+    ``after``: config -> configs whose products it starts from (run first). ``scheduler``
+    is the address of a running Dask scheduler; without it a local cluster of ``workers``
+    single-threaded processes is started.
     """
     from distributed import Client, LocalCluster, as_completed
 
-    configs = [str(c) for c in configs]
+    after = {str(c): [str(d) for d in ds] for c, ds in (after or {}).items()}
+    configs = dependency_order([str(c) for c in configs], after)
     cluster = None if scheduler else LocalCluster(n_workers=workers, threads_per_worker=1,
                                                   processes=True, dashboard_address=":0")  # any free port: never clash with a running cluster
     outcomes: list[ArcOutcome] = []
     with Client(scheduler or cluster) as client:
-        futures = [client.submit(_guarded, run_one, c, key=f"arc-{i}", pure=False) for i, c in enumerate(configs)]
+        futures = {}
+        for i, c in enumerate(configs):
+            futures[c] = client.submit(_guarded, run_one, c, *[futures[d] for d in after.get(c, ())],
+                                       key=f"arc-{i}", pure=False)
+        futures = list(futures.values())
         for k, fut in enumerate(as_completed(futures), start=1):
             out = fut.result()
             outcomes.append(out)

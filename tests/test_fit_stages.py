@@ -1,0 +1,54 @@
+"""Data-weight stages and step halving of the iterated filter-smoother (two-body arc with simulated truth)."""
+
+import numpy as np
+import pytest
+
+from odpipe.estimation.fit import FitOptions, fit
+from odpipe.estimation.testing import twobody_case
+
+DAY = 86400.0
+
+
+@pytest.fixture(scope="module")
+def case():
+    prob, obs, truth = twobody_case(np.random.default_rng(3))
+    plain = fit(prob, obs, 0.0, DAY, FitOptions(block=600.0))
+    return prob, obs, truth, plain
+
+
+def test_staged_weights_reach_the_same_solution(case):
+    prob, obs, truth, plain = case
+    staged = fit(prob, obs, 0.0, DAY, FitOptions(block=600.0, sigma_scale=(100.0, 10.0, 1.0), max_iter=15))
+    assert plain.converged and staged.converged
+    scales = [h["sigma_scale"] for h in staged.history]
+    assert scales[0] == 100.0 and scales[-1] == 1.0 and scales == sorted(scales, reverse=True)
+    sig = np.sqrt(np.diag(plain.P0))
+    assert np.max(np.abs(staged.x0 - plain.x0) / sig) < 1e-2
+    np.testing.assert_allclose(np.sqrt(np.diag(staged.P0)), sig, rtol=1e-6)
+    d = staged.x0 - truth["x0"]
+    assert d @ np.linalg.solve(staged.P0, d) < 40.0   # chi-square, 15 parameters, far below 0.1 %
+
+
+class _FailsOnce:
+    """The problem, except that the first corrected reference 'cannot be integrated'."""
+
+    def __init__(self, problem, x_apriori):
+        self.problem, self.registry, self.x_apriori, self.failed = problem, problem.registry, x_apriori, False
+
+    def transition(self, t0, t1, x0):
+        if not self.failed and t0 == 0.0 and not np.allclose(x0[:6], self.x_apriori[:6]):
+            self.failed = True
+            raise RuntimeError("DOP853: step size underflow")
+        return self.problem.transition(t0, t1, x0)
+
+    def predict(self, t0, x0, rows):
+        return self.problem.predict(t0, x0, rows)
+
+
+def test_a_reference_that_cannot_be_integrated_halves_the_step(case):
+    prob, obs, truth, plain = case
+    flaky = _FailsOnce(prob, prob.registry.apriori.copy())
+    sol = fit(flaky, obs, 0.0, DAY, FitOptions(block=600.0))
+    assert flaky.failed and sol.converged
+    assert sol.history[1]["halvings"] == 1
+    assert np.max(np.abs(sol.x0 - plain.x0) / np.sqrt(np.diag(plain.P0))) < 1e-2
