@@ -1,8 +1,8 @@
 """GRAIL-B: the effect of the lunar field's degree on post-fit residuals, daily-arc overlaps and run time.
 
 Runs the daily arcs ``grail_b_2012_04_09`` and ``grail_b_2012_04_10`` (their overlap is
-2012-04-10 04:00-07:00 UTC) with the LP field (``lpe200``) truncated at each degree,
-everything else as configured, and writes into OUT (default ``runs/out/grail_degree_study``):
+2012-04-10 04:00-07:00 UTC; the second starts from the first's solution, as configured) with the
+LP field (``lpe200``) truncated at each degree, everything else as configured, and writes into OUT (default ``runs/out/grail_degree_study``):
 
 * ``degree_study.csv`` / ``degree_study.md``: per degree and arc, post-fit 60-s two-way
   Doppler RMS per station in mm/s and mHz, fit time and run time; per degree, the overlap
@@ -10,7 +10,8 @@ everything else as configured, and writes into OUT (default ``runs/out/grail_deg
 * ``passes.csv``: post-fit RMS per station and pass (mm/s, mHz) for every run;
 * ``degree_study.png``: residual RMS and overlap against degree.
 
-Run: ``.venv/bin/python runs/grail_degree_study.py [OUT] [--degrees 50 100 150 200]``
+Run: ``.venv/bin/python runs/grail_degree_study.py [OUT] [--degrees 50 100 150 200]`` after
+``odpipe run runs/grail_b_2012_04_09_start.toml`` (the a priori of 04-09).
 """
 
 from __future__ import annotations
@@ -44,6 +45,10 @@ def derived_config(arc: str, degree: int, out: Path) -> Path:
     text = re.sub(r"^degree = \d+", f"degree = {degree}", text, flags=re.M)
     text = re.sub(r'^name = "[^"]+"', f'name = "{arc}_deg{degree}"', text, count=1, flags=re.M)
     text = re.sub(r'^output = "[^"]+"', f'output = "{out}"', text, count=1, flags=re.M)
+    # a chained a priori comes from the study's own run of a studied arc at this degree, else from runs/out
+    text = re.sub(r'^from_oem = "out/([^/"]+)/current/trajectory.oem"', lambda m: 'from_oem = "{}"'.format(
+        (out / f"{m.group(1)}_deg{degree}" if m.group(1) in ARCS else HERE / "out" / m.group(1))
+        / "current" / "trajectory.oem"), text, flags=re.M)
     path = out / f"{arc}_deg{degree}.toml"
     path.write_text(text)
     return path

@@ -3,7 +3,7 @@
 import numpy as np
 import pytest
 
-from odpipe.estimation.fit import FitOptions, fit
+from odpipe.estimation.fit import FitDiverged, FitOptions, Observations, fit
 from odpipe.estimation.testing import twobody_case
 
 DAY = 86400.0
@@ -52,3 +52,10 @@ def test_a_reference_that_cannot_be_integrated_halves_the_step(case):
     assert flaky.failed and sol.converged
     assert sol.history[1]["halvings"] == 1
     assert np.max(np.abs(sol.x0 - plain.x0) / np.sqrt(np.diag(plain.P0))) < 1e-2
+
+
+def test_a_fit_left_far_off_raises_instead_of_returning_products(case):
+    prob, obs, _, _ = case
+    wrong = Observations(obs.time, obs.value * 1.001, obs.sigma, obs.group)  # no orbit fits these
+    with pytest.raises(FitDiverged, match="not converged in 2 iterations"):
+        fit(prob, wrong, 0.0, DAY, FitOptions(block=600.0, max_iter=2))

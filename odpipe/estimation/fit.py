@@ -64,18 +64,22 @@ class Observations:
 @dataclass(frozen=True)
 class FitOptions:
     """max_iter; block: regular grid spacing (s); edit_k: innovation-test k-sigma per
-    iteration (last value repeats; inf = off), applied only once the previous
-    post-fit RMS (whitened) is below edit_gate_rms, so that a far-off first
-    reference does not reject good data; reweight: scale each group's sigma by
-    its post-fit RMS; sigma_scale: data-weight stages, each multiplying every sigma (e.g.
-    (30, 5, 1)): a far-off reference is first fitted with loose weights, and the next
-    stage starts once the epoch correction is below stage_tol sigma, so the tight fit
-    starts inside its linear regime (the first pass of a stage edits nothing); max_halvings: when the models cannot be evaluated
-    about a corrected reference (e.g. an orbit driven into the central body), the correction
-    is halved up to this many times before FitDiverged; tol_dx: converged (at the last stage) when every
-    epoch correction < tol_dx sigma and the post-fit RMS changed by < tol_rms (relative); extra_epochs: more grid epochs
-    (TDB s); output_at_measurements: put every observation time on the grid, so
-    filtered and smoothed estimates exist at each measurement time."""
+    iteration (last value repeats; inf = off), applied only once the previous post-fit
+    RMS (whitened) is below edit_gate_rms, so that a far-off first reference does not
+    reject good data; reweight: scale each group's sigma by its post-fit RMS (last stage).
+
+    sigma_scale: data-weight stages multiplying every sigma, loose to tight (e.g. (30, 5, 1)):
+    a far-off reference is first fitted with loose weights; the next stage starts once the
+    epoch correction is below stage_tol sigma, inside the tight fit's linear regime, and its
+    first pass edits nothing. max_halvings: when the models cannot be evaluated about a
+    corrected reference (an orbit driven into the central body), the correction is halved
+    up to this many times before FitDiverged, which is also raised when the iterations end
+    unconverged with the post-fit RMS above diverged_rms sigma.
+
+    tol_dx: converged (at the last stage) when every epoch correction < tol_dx sigma and
+    the post-fit RMS changed by < tol_rms (relative); extra_epochs: more grid epochs (TDB s);
+    output_at_measurements: put every observation time on the grid, so filtered and
+    smoothed estimates exist at each measurement time."""
 
     max_iter: int = 10
     block: float = 600.0
@@ -85,6 +89,7 @@ class FitOptions:
     sigma_scale: tuple = (1.0,)
     stage_tol: float = 1.0
     max_halvings: int = 6
+    diverged_rms: float = 100.0
     tol_dx: float = 1e-2
     tol_rms: float = 1e-3
     extra_epochs: tuple = ()
@@ -261,6 +266,8 @@ def fit(problem: Problem, obs: Observations, t_start: float, t_end: float,
             converged = True
             break
 
+    if not converged and rms > options.diverged_rms:
+        raise FitDiverged(f"not converged in {options.max_iter} iterations; post-fit RMS {rms:.3g} sigma")
     refs = np.array(ps.refs)
     residuals = pd.DataFrame({"time": obs.time, "group": obs.group, "prefit": ps.prefit,
                               "postfit": postfit, "innovation": ps.innovation,
