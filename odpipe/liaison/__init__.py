@@ -5,6 +5,9 @@
 * :mod:`.pair` - one experiment: simulation, Monte Carlo trial, CRLB, Gramian;
 * :mod:`.turan` - scenario 2 (Turan et al.: range-only vs range-rate-only);
 * :mod:`.baseline` - scenario 1 (Fujimoto et al. sec. 2.1: GEO + L1 halo);
+* :mod:`.doppler` - scenario 1b (Fujimoto et al. secs. 3-4: two-way crosslink Doppler, high fidelity);
+* :mod:`.dowr` - scenario 3 (Li et al.: DRO-LEO dual one-way ranging, Table 13);
+* :mod:`.ground` - scenario 4 (Leonard's thesis sec. 8.1: ground tracking with and without LiAISON);
 * :mod:`.report` - tables and convergence plots of a scenario run.
 
 Run with ``odpipe liaison runs/liaison_X.toml -o DIR``.
