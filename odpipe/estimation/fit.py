@@ -217,7 +217,8 @@ def fit(problem: Problem, obs: Observations, t_start: float, t_end: float,
                 break
             except (RuntimeError, ValueError) as err:  # e.g. an orbit driven into the body, light time off its span
                 if last_step is None or halving == options.max_halvings:
-                    raise FitDiverged(f"iteration {it + 1}: the reference cannot be integrated ({err})") from err
+                    raise FitDiverged(f"iteration {it + 1}: the models cannot be evaluated about the "
+                                      f"reference ({err})") from err
                 step_x, step_p = last_step
                 last_step = (0.5 * step_x, {key: 0.5 * v for key, v in step_p.items()})
                 x_ref0 = x_ref0 - last_step[0]
