@@ -3,7 +3,7 @@
 import numpy as np
 import pytest
 
-from odpipe.estimation.fit import FitDiverged, FitOptions, Observations, fit
+from odpipe.estimation.fit import FitDiverged, FitOptions, fit
 from odpipe.estimation.testing import twobody_case
 
 DAY = 86400.0
@@ -54,8 +54,23 @@ def test_a_reference_that_cannot_be_integrated_halves_the_step(case):
     assert np.max(np.abs(sol.x0 - plain.x0) / np.sqrt(np.diag(plain.P0))) < 1e-2
 
 
-def test_a_fit_left_far_off_raises_instead_of_returning_products(case):
+class _Worsening:
+    """The problem, with a model error (alternating in sign, 300 sigma more at each pass) no
+    parameter absorbs: the iterations can only make the fit worse."""
+
+    def __init__(self, problem, sigma):
+        self.problem, self.registry, self.sigma, self.passes = problem, problem.registry, sigma, 0
+
+    def transition(self, t0, t1, x0):
+        self.passes += t0 == 0.0
+        return self.problem.transition(t0, t1, x0)
+
+    def predict(self, t0, x0, rows):
+        value, H = self.problem.predict(t0, x0, rows)
+        return value + (-1.0) ** rows * 300.0 * (self.passes - 1) * self.sigma[rows], H
+
+
+def test_a_fit_made_worse_by_its_iterations_raises_instead_of_returning_products(case):
     prob, obs, _, _ = case
-    wrong = Observations(obs.time, obs.value * 1.001, obs.sigma, obs.group)  # no orbit fits these
-    with pytest.raises(FitDiverged, match="not converged in 2 iterations"):
-        fit(prob, wrong, 0.0, DAY, FitOptions(block=600.0, max_iter=2))
+    with pytest.raises(FitDiverged, match="not converged in 3 iterations"):
+        fit(_Worsening(prob, obs.sigma), obs, 0.0, DAY, FitOptions(block=600.0, max_iter=3, edit_k=(np.inf,)))

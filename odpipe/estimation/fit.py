@@ -74,7 +74,7 @@ class FitOptions:
     first pass edits nothing. max_halvings: when the models cannot be evaluated about a
     corrected reference (an orbit driven into the central body), the correction is halved
     up to this many times before FitDiverged, which is also raised when the iterations end
-    unconverged with the post-fit RMS above diverged_rms sigma.
+    unconverged with the post-fit RMS above diverged_rms sigma and above its best iteration's.
 
     tol_dx: converged (at the last stage) when every epoch correction < tol_dx sigma and
     the post-fit RMS changed by < tol_rms (relative); extra_epochs: more grid epochs (TDB s);
@@ -267,8 +267,10 @@ def fit(problem: Problem, obs: Observations, t_start: float, t_end: float,
             converged = True
             break
 
-    if not converged and rms > options.diverged_rms:
-        raise FitDiverged(f"not converged in {options.max_iter} iterations; post-fit RMS {rms:.3g} sigma")
+    best = min(h["postfit_rms"] for h in history)
+    if not converged and not rms <= max(options.diverged_rms, best):  # NaN: everything edited
+        raise FitDiverged(f"not converged in {options.max_iter} iterations; post-fit RMS {rms:.3g} sigma "
+                          f"(best iteration {best:.3g})")
     refs = np.array(ps.refs)
     residuals = pd.DataFrame({"time": obs.time, "group": obs.group, "prefit": ps.prefit,
                               "postfit": postfit, "innovation": ps.innovation,
