@@ -61,7 +61,8 @@ def test_unchanged_arc_is_skipped_and_failed_rerun_keeps_products(case):
 
 def test_next_arc_starts_from_this_arcs_oem(case):
     """A nightly chain: the a priori of the next arc is this arc's OEM state; batch runs this arc first."""
-    from odpipe.commands.batch import starts_from
+    from odpipe.commands.batch import night_report, starts_from
+    from odpipe.runs.batch import ArcOutcome
     from odpipe.pipeline.config import load_config
     from odpipe.pipeline.setup import initial_state, tdb
     from odpipe.time import tdb_to_utc
@@ -87,3 +88,10 @@ def test_next_arc_starts_from_this_arcs_oem(case):
     state = par[par["kind"] == "state"]
     err = state["estimate"].to_numpy() - truth.state(np.array([tdb(start2)]))[0]
     assert np.all(np.abs(err) < 3 * state["sigma"].to_numpy()), (err, state["sigma"].to_numpy())
+    arcs = [tmp / "arc.toml", tmp / "next.toml"]
+    night_report(tmp / "night", arcs, [ArcOutcome(str(a), "complete", 1.0) for a in arcs])
+    overlaps = pd.read_csv(tmp / "night" / "overlap_arcs.csv")
+    assert overlaps["overlap"].iloc[0] == "sim_arc - sim_arc_next" and len(overlaps) == 3  # + mean, std
+    assert overlaps["pos_3d_rms"].iloc[0] < 100.0  # m: two fits of one truth, each within tens of metres
+    stats = pd.read_csv(tmp / "night" / "residual_statistics.csv")
+    assert set(stats["arc"]) == {"sim_arc", "sim_arc_next"} and (tmp / "night" / "report.html").is_file()

@@ -134,6 +134,27 @@ def summarize(overlaps: list[Overlap]) -> pd.DataFrame:
     return pd.concat([table, pd.DataFrame([mean, std])], ignore_index=True)
 
 
+def consecutive_overlaps(trajs: dict, order, out, label: str, title: str = "", step: float = 600.0):
+    """Overlaps of consecutive arcs in ``order`` (names in ``trajs``) whose spans overlap: the
+    summary table written to ``out/overlap_{label}.csv`` and its position and velocity plots.
+
+    Returns (table, [png paths]), or (None, []) when no consecutive arcs overlap.
+    """
+    from odpipe.products.atomic import write_text
+
+    names = list(order)
+    pairs = [(a, b) for a, b in zip(names[:-1], names[1:]) if trajs[a].t1 > trajs[b].t0]
+    if not pairs:
+        return None, []
+    table = summarize([compare(trajs[a], trajs[b], f"{a} - {b}", step) for a, b in pairs])
+    write_text(out / f"overlap_{label}.csv", table.to_csv(index=False))
+    pngs = []
+    for q in ("pos", "vel"):
+        pngs.append(out / f"overlap_{label}_{q}.png")
+        plot_overlaps(table, pngs[-1], q, f"{title or label} {'position' if q == 'pos' else 'velocity'} overlaps")
+    return table, pngs
+
+
 def short_arc_schedule(maneuvers_tdb, arc_days: float = 5.0, margin_s: float = 3600.0):
     """Short-arc overlap pairs between consecutive maneuvers (seed 004 §4.5).
 

@@ -25,7 +25,7 @@ import numpy as np
 import pandas as pd
 
 from odpipe.analysis import maneuvers as maneuver_report
-from odpipe.analysis.overlap import compare, oem_trajectory, plot_overlaps, summarize
+from odpipe.analysis.overlap import consecutive_overlaps, oem_trajectory
 from odpipe.pipeline.run import run_config
 from odpipe.products.atomic import write_text
 from odpipe.products.spk import SpkTrajectory
@@ -167,16 +167,12 @@ def _report(out: Path, case, plan, files, truth) -> dict:
     traj = {n: oem_trajectory(runs / n / "current" / "trajectory.oem") for n, *_ in done}
     sections, headline = [], {"case": case.name, "arcs fitted": f"{len(done)} of {len(plan)}"}
     for kind in ("short", "long"):
-        names = [n for n, k, *_ in done if k == kind]
-        pairs = [(a, b) for a, b in zip(names[:-1], names[1:]) if traj[a].t1 > traj[b].t0]
-        if not pairs:
+        table, pngs = consecutive_overlaps(traj, [n for n, k, *_ in done if k == kind], out, kind,
+                                           f"{kind.capitalize()}-arc")
+        if table is None:
             continue
-        table = summarize([compare(traj[a], traj[b], f"{a} - {b}", 600.0) for a, b in pairs])
-        write_text(out / f"overlap_{kind}.csv", table.to_csv(index=False))
         sec = Section(f"{kind.capitalize()}-arc overlaps (RIC differences over each overlap)").table(table)
-        for q in ("pos", "vel"):
-            png = out / f"overlap_{kind}_{q}.png"
-            plot_overlaps(table, png, q, f"{kind.capitalize()}-arc {'position' if q == 'pos' else 'velocity'} overlaps")
+        for png in pngs:
             sec.figure(png, png.stem)
         sections.append(sec)
         mean, std = table.iloc[-2], table.iloc[-1]
