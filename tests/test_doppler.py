@@ -134,19 +134,19 @@ def _one_way(traj, st, t3e, tc, **kw):
     t3s = t3e - np.timedelta64(int(tc * 1e9), "ns")
     nodes = [SpacecraftNode(traj, None, "earth"), st]
     sols = [solve_path(nodes, a[0], t_corr=a[1], shapiro_bodies=()) for a in (anchor_from_utc(t3s), anchor_from_utc(t3e))]
-    return one_way_doppler(sols[0], sols[1], 8.4e9, 8.4e9, tc, **kw)
+    return one_way_doppler(sols[0], sols[1], 8.4e9, tc, **kw)
 
 
 def test_one_way_doppler_sign_scale_and_oscillator_partials():
     traj, st = _scenario(1000.0)
     base = _one_way(traj, st, EPOCHS, 60.0)
     assert np.all(base.value > 0.4 * 8.4e9 * 1000.0 / C_LIGHT)
-    # an oscillator high by 1 Hz lowers the observable by 1 Hz (f_ref - f_received)
-    hi = _one_way(traj, st, EPOCHS, 60.0, freq_bias=1.0)
-    np.testing.assert_allclose(hi.value - base.value, base.params["freq_bias"], rtol=1e-9)
-    assert np.allclose(base.params["freq_bias"], -1.0, atol=1e-5)
-    dr = _one_way(traj, st, EPOCHS, 60.0, freq_drift=1e-6, t_ref=0.0)
-    np.testing.assert_allclose((dr.value - base.value) / 1e-6, base.params["freq_drift"], rtol=1e-6)
+    # an oscillator high by 1 Hz (y0 = 1 / 8.4e9) lowers the observable by 1 Hz (f_ref - f_received)
+    hi = _one_way(traj, st, EPOCHS, 60.0, y0=1.0 / 8.4e9)
+    np.testing.assert_allclose(hi.value - base.value, -1.0, atol=1e-5)
+    np.testing.assert_allclose(hi.value - base.value, base.params["osc_y0"] / 8.4e9, rtol=1e-9)
+    dr = _one_way(traj, st, EPOCHS, 60.0, y1=1e-16, t_ref=0.0)
+    np.testing.assert_allclose((dr.value - base.value) / 1e-16, base.params["osc_y1"], rtol=1e-6)
     # velocity partials vs finite differences
     fd = np.zeros((EPOCHS.size, 3))
     for i in range(3):
@@ -155,3 +155,15 @@ def test_one_way_doppler_sign_scale_and_oscillator_partials():
         fd[:, i] = (_one_way(traj.with_epoch_state(traj.x0 + dx), st, EPOCHS, 60.0).value
                     - _one_way(traj.with_epoch_state(traj.x0 - dx), st, EPOCHS, 60.0).value) / 0.02
     np.testing.assert_allclose(epoch_state_partials(base, "spacecraft", traj)[:, 3:], fd, rtol=1e-5)
+
+
+def test_proper_rate_at_the_geocenter_averages_to_iers_lc():
+    """1 - dτ/dt of a clock at the geocentre, from the bodies external to the Earth, averaged over 2000-2020,
+    is the IERS 2010 constant L_C = 1.48082686741e-8 (the mean rate of TCG against TCB)."""
+    from odpipe.environment.ephemeris import Ephemeris
+    from odpipe.measurements.nodes import proper_rate_offset
+
+    t = np.linspace(0.0, 20 * 365.25 * 86400.0, 20000)
+    rate = proper_rate_offset(Ephemeris.open("de440"), "earth", t, np.zeros((t.size, 6)),
+                              bodies=("sun", "moon", "venus", "mars", "jupiter", "saturn"))
+    assert abs(np.mean(rate) - 1.48082686741e-8) < 1e-13

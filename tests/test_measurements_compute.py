@@ -60,7 +60,7 @@ def setup():
     ramp = pd.DataFrame({"station": ["DSS-25"], "start": [T0 - np.timedelta64(1, "h")], "end": [T0 + np.timedelta64(9, "h")],
                          "freq_hz": [7.16e9], "rate_hz_s": [0.3], "band": ["X"], "source": ["t"], "record": [0]})
     base.ramps = RampStore(ramp)
-    base.oscillators = {"A": (8.4e9, 0.5, 1e-5, 0.0)}
+    base.oscillators = {"A": (6e-11, 1.2e-15, 0.0)}
     base.clocks = {"A": ClockModel(1e-6, 1e-10, 0.0, 8e8)}
     return base
 

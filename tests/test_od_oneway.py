@@ -1,7 +1,7 @@
 """One-way Doppler: the spacecraft oscillator's bias and drift are fitted with the orbit.
 
-Truth: X-band oscillator 8.4 GHz with a 0.05 Hz bias (1.8 mm/s) and a 2e-7 Hz/s drift
-(0.035 Hz over the 2 days); one-way Doppler every 60 s (0.1 mm/s) and two-way range
+Truth: X-band oscillator 8.4 GHz with a 0.05 Hz bias (y0 = 5.95e-12, 1.8 mm/s) and a 2e-7 Hz/s drift
+(y1 = 2.4e-17 /s, 0.035 Hz over the 2 days); one-way Doppler every 60 s (0.1 mm/s) and two-way range
 every 600 s from the same three stations, over the 2-day HEO arc of test_od_truth
 (without the maneuver). The fit starts from a zero bias and drift.
 """
@@ -15,25 +15,53 @@ import numpy as np
 from odpipe.od import ArcSetup, fit_arc, simulate_tracking
 from test_od_simulate import arc_state, force_model, measurement_setup, scenario
 
-F0, BIAS, DRIFT = 8.4e9, 0.05, 2e-7
+F0 = 8.4e9
+Y0, Y1 = 0.05 / F0, 2e-7 / F0
 
 
 def test_oscillator_bias_drift_and_state_within_3_sigma():
     sc = scenario(maneuver=False)
     t_ref = sc["t0"]
-    truth_setup = replace(measurement_setup(), oscillators={"SC": (F0, BIAS, DRIFT, t_ref)})
+    truth_setup = replace(measurement_setup(), oscillators={"SC": (Y0, Y1, t_ref)})
     plan = replace(sc["plan"], doppler="doppler_1way", uplink_hz=F0, range_bias_sigma=0.0)
     table, _ = simulate_tracking(sc["truth"], plan, truth_setup, np.random.default_rng(5))
     assert set(table["observable"]) == {"doppler_1way", "range"}
-    fit_setup = replace(measurement_setup(), oscillators={"SC": (F0, 0.0, 0.0, t_ref)})
+    fit_setup = replace(measurement_setup(), oscillators={"SC": (0.0, 0.0, t_ref)})
     setup = ArcSetup("SC", sc["t0"], sc["t1"], arc_state(sc), force_model(), fit_setup,
                      data_sigma={"range": 1.0, "doppler_1way": 1e-4}, range_bias_sigma=None,
-                     oscillator_sigma=(1.0, 1e-5))
+                     oscillator_sigma=(1.0 / F0, 1e-5 / F0))
     sol = fit_arc(table, setup)
     assert sol.converged and 0.95 < sol.history[-1]["postfit_rms"] < 1.05
     p = sol.parameters.set_index("name")
-    for name, true in (("SC.osc_bias", BIAS), ("SC.osc_drift", DRIFT)):
+    for name, true in (("SC.osc_y0", Y0), ("SC.osc_y1", Y1)):
         est, sig = p.loc[name, "estimate"], p.loc[name, "sigma"]
         assert abs(est - true) < 3 * sig and sig < 0.1 * abs(true), (name, est, sig)
     err = sol.states[0] - sc["x0"]
     assert np.all(np.abs(err) < 3 * np.sqrt(np.diag(sol.covariances[0])))
+
+
+def test_one_oscillator_serves_s_and_x_band_one_way_rows():
+    """S-band (2.3 GHz) and X-band (8.4 GHz) one-way Doppler from one oscillator: the fractional offset and
+    drift are one pair for both bands (a Hz bias could not serve both), recovered within 3 sigma."""
+    import pandas as pd
+
+    sc = scenario(maneuver=False)
+    t_ref = sc["t0"]
+    truth_setup = replace(measurement_setup(), oscillators={"SC": (Y0, Y1, t_ref)})
+    tables = []
+    for k, (band, f) in enumerate((("X", F0), ("S", 2.3e9))):
+        plan = replace(sc["plan"], doppler="doppler_1way", uplink_hz=f, band=band, range_bias_sigma=0.0,
+                       doppler_step=120.0, range_step=1e9 if k else 600.0)
+        tables.append(simulate_tracking(sc["truth"], plan, truth_setup, np.random.default_rng(11 + k))[0])
+    table = pd.concat(tables, ignore_index=True).sort_values("epoch", kind="stable", ignore_index=True)
+    assert set(table.loc[table["observable"] == "doppler_1way", "band_down"]) == {"S", "X"}
+    fit_setup = replace(measurement_setup(), oscillators={"SC": (0.0, 0.0, t_ref)})
+    setup = ArcSetup("SC", sc["t0"], sc["t1"], arc_state(sc), force_model(), fit_setup,
+                     data_sigma={"range": 1.0, "doppler_1way": 1e-4}, range_bias_sigma=None,
+                     oscillator_sigma=(1.0 / F0, 1e-5 / F0))
+    sol = fit_arc(table, setup)
+    assert sol.converged and 0.9 < sol.history[-1]["postfit_rms"] < 1.1
+    p = sol.parameters.set_index("name")
+    for name, true in (("SC.osc_y0", Y0), ("SC.osc_y1", Y1)):
+        est, sig = p.loc[name, "estimate"], p.loc[name, "sigma"]
+        assert abs(est - true) < 3 * sig and sig < 0.1 * abs(true), (name, est, sig)

@@ -36,7 +36,7 @@ rows that do not involve the group):
 ``state:<sc>`` (6, d/d epoch state of the trajectory), ``dynamic:<sc>``
 (p, ``traj.param_names``), ``station:<name>`` (3, ITRS m), ``bias`` (1, unit of
 the row), ``delay`` (1, per s of range delay), ``media_scale`` (1),
-``oscillator:<sc>`` (2: Hz bias, Hz/s drift), ``clock:<sc>`` (3: c*a0, c*a1, c*a2).
+``oscillator:<sc>`` (2: fractional offset y0, drift y1 1/s), ``clock:<sc>`` (3: c*a0, c*a1, c*a2).
 Trajectories without ``stm`` (reference ephemerides) give values but no state groups.
 Rows that cannot be computed get NaN and a reason in :attr:`Evaluation.status`.
 """
@@ -57,7 +57,7 @@ from . import angles, crosslink, dsn, instantaneous
 from .bands import ONE_WAY_SCALE, band_name, range_unit_factor, turnaround_ratio
 from .computed import Computed, ConstantUplink
 from .lighttime import anchor_from_utc, solve_path
-from .nodes import SpacecraftNode, StationNode
+from .nodes import SpacecraftNode, StationNode, proper_rate_offset
 from .partials import dynamic_partials, epoch_state_partials, station_partials
 
 _ANGLES = {"angle_az": "azimuth", "angle_el": "elevation", "angle_x": "x", "angle_y": "y"}
@@ -67,7 +67,8 @@ _ANGLES = {"angle_az": "azimuth", "angle_el": "elevation", "angle_x": "x", "angl
 class MeasurementSetup:
     """Everything the models need besides rows and trajectories; built once per run.
 
-    oscillators: spacecraft -> (f_nominal Hz, bias Hz, drift Hz/s, t_ref TDB s) for one-way Doppler.
+    oscillators: spacecraft -> (y0, y1 1/s, t_ref TDB s) of its one-way oscillator: fractional frequency
+    offset from each row's reference frequency and its drift (:func:`.dsn.one_way_doppler`).
     clocks: spacecraft -> :class:`.crosslink.ClockModel` for dual one-way ranging.
     """
 
@@ -201,11 +202,13 @@ def _evaluate(key, g, trajectories, setup):
         f_ref = g["uplink_hz"].to_numpy(float)
         if "odf_data_type" in g.columns:  # ODF gives the one-way reference at S-band scale (parsers.odf)
             f_ref = f_ref * ONE_WAY_SCALE.get(band_name(g["band_down"].iloc[0]), np.nan)
-        f0, bias, drift, t_ref = setup.oscillators.get(sc, (f_ref, 0.0, 0.0, 0.0))
+        y0, y1, t_ref = setup.oscillators.get(sc, (0.0, 0.0, 0.0))
         s, e = interval()
-        comp = dsn.one_way_doppler(solve(nodes, s), solve(nodes, e), f_ref, f0, g["count_time"].to_numpy(float),
-                                   bias, drift, t_ref)
-        comp.params[f"oscillator:{sc}"] = np.stack([comp.params.pop("freq_bias"), comp.params.pop("freq_drift")], 1)
+        sols = solve(nodes, s), solve(nodes, e)
+        proper = 0.5 * sum(proper_rate_offset(setup.ephemeris, setup.origin, p.epochs[:, 0] + p.epoch_corr[:, 0],
+                                              p.states[:, 0]) for p in sols)
+        comp = dsn.one_way_doppler(*sols, f_ref, g["count_time"].to_numpy(float), y0, y1, t_ref, proper)
+        comp.params[f"oscillator:{sc}"] = np.stack([comp.params.pop("osc_y0"), comp.params.pop("osc_y1")], 1)
         return comp, {"station_rx": ("station", rx, st_rx), "spacecraft": ("sc", sc, traj)}
     if obs in _ANGLES:
         st_rx = setup.station(rx)
@@ -293,7 +296,7 @@ def _store(out: Evaluation, idx, n, comp: Computed, roles, g, setup):
         v = v[:, None] if v.ndim == 1 else v
         names = {"bias": ["bias"], "delay": ["delay_s"]}.get(k.split(":")[0])
         if k.startswith("oscillator:"):
-            names = ["freq_bias_hz", "freq_drift_hz_s"]
+            names = ["y0", "y1_per_s"]
         elif k.startswith("clock:"):
             names = ["c_a0", "c_a1", "c_a2"]
         _put(out, k, names, idx, n, v)

@@ -101,24 +101,30 @@ def dsn_doppler(sol_s, sol_e, uplink, station_tx, t3s_utc, t3e_utc, m2, referenc
     return Computed(value, "Hz", events, {"bias": np.ones_like(value)}, to_los=C_LIGHT / (2 * m2 * f1e))
 
 
-def one_way_doppler(sol_s, sol_e, f_ref, f_sc, count_time, freq_bias=0.0, freq_drift=0.0, t_ref=0.0) -> Computed:
+def one_way_doppler(sol_s, sol_e, f_ref, count_time, y0=0.0, y1=0.0, t_ref=0.0, proper=0.0) -> Computed:
     """One-way Doppler (Hz) of paths ``[spacecraft, station_rx]`` anchored at t3s and t3e.
 
-    ``f_ref``: the station's reference (Hz); ``f_sc``: nominal spacecraft
-    oscillator (Hz); ``freq_bias`` (Hz), ``freq_drift`` (Hz/s) about ``t_ref`` (TDB s).
-    Parameters: 'freq_bias', 'freq_drift' (the estimable oscillator terms), 'bias' (Hz).
+    ``f_ref``: the station's reference, the transmitted frequency it expects (Hz). The spacecraft
+    oscillator transmits ``f_ref (1 + y0 + y1 (t2 - t_ref))``: ``y0`` fractional frequency offset,
+    ``y1`` its drift (1/s) about ``t_ref`` (TDB s), so one oscillator serves every band it drives.
+    That frequency is in the spacecraft's proper time; ``proper`` (N,) is 1 - dτ/dt over the count
+    (:func:`.nodes.proper_rate_offset`), which lowers it in TDB (±175 mm/s at X band about the Moon).
+    Parameters: 'osc_y0', 'osc_y1' (the estimable oscillator terms), 'bias' (Hz).
     """
     tc = np.asarray(count_time, dtype=float)
     dtau = sol_e.light_time - sol_s.light_time
     dclk = sol_e.clock[:, -1] - sol_s.clock[:, -1]
     span = tc + dclk - dtau  # t2e - t2s, TDB s
     t2_mid = 0.5 * ((sol_s.epochs[:, 0] + sol_s.epoch_corr[:, 0]) + (sol_e.epochs[:, 0] + sol_e.epoch_corr[:, 0]))
-    f_mean = f_sc + freq_bias + freq_drift * (t2_mid - t_ref)
+    f_ref = np.asarray(f_ref, dtype=float)
+    f_mean = f_ref * (1.0 + y0 + y1 * (t2_mid - t_ref)) * (1.0 - proper)
     value = (f_ref - f_mean) + f_mean * (dtau - dclk) / tc
     events = []
     for sol, sign in ((sol_e, 1.0), (sol_s, -1.0)):
         gain = sign * f_mean / tc
         events += [EventPartial("spacecraft", sol.epochs[:, 0], gain[:, None] * sol.dlt_dr[:, 0]),
                    EventPartial("station_rx", sol.epochs[:, 1], gain[:, None] * sol.dlt_dr[:, 1])]
-    params = {"freq_bias": -span / tc, "freq_drift": -(t2_mid - t_ref) * span / tc, "bias": np.ones_like(value)}
+    scale = -f_ref * (1.0 - proper) * span / tc
+    params = {"osc_y0": scale, "osc_y1": scale * (t2_mid - t_ref),
+              "bias": np.ones_like(value)}
     return Computed(value, "Hz", events, params, to_los=C_LIGHT / f_mean)

@@ -11,7 +11,8 @@ A *node* answers two questions at TDB epochs ``t`` (s past J2000, shape (N,)):
   through ERFA) + the topocentric term (v_earth . r_station)/c^2. The topocentric
   term is at most 2.1 us; its change over a lunar round trip is below 0.4 ns
   (12 cm of path) and it is kept because it costs one dot product. Spacecraft
-  count in TDB here (0): their clocks are modelled by estimated clock parameters.
+  count in TDB here (0): their clocks are modelled by estimated clock parameters,
+  and a spacecraft oscillator's proper-time rate by :func:`proper_rate_offset`.
 
 Ephemeris objects follow ``odpipe.environment.ephemeris.Ephemeris``:
 ``state(target, center, t) -> (N, 6)`` in m, m/s.
@@ -48,6 +49,23 @@ def origin_state(ephemeris, body: str, origin: str, t: np.ndarray) -> np.ndarray
     if ephemeris is None:
         raise ValueError(f"an ephemeris is needed for the state of {body!r} relative to {origin!r}")
     return np.asarray(ephemeris.state(body, origin, t), dtype=float).reshape(t.size, 6)
+
+
+PROPER_TIME_BODIES = ("sun", "earth", "moon", "jupiter")
+
+
+def proper_rate_offset(ephemeris, origin: str, t: np.ndarray, state: np.ndarray,
+                       bodies=PROPER_TIME_BODIES) -> np.ndarray:
+    """1 - d(proper time)/d(TDB coordinate time) of a clock at ``state`` (N,6, relative to ``origin``) at
+    TDB ``t``: (U + v^2/2)/c^2 with barycentric velocity v and the Newtonian potential U of ``bodies``
+    (IERS 2010 eq. 10.6 to 1/c^2). About 1.5e-8 near the Earth-Moon system, its
+    constant part being IERS L_C; about a lunar orbiter it varies by ~5e-10 with the orbit."""
+    t = np.atleast_1d(np.asarray(t, dtype=float))
+    bary = np.asarray(state, dtype=float) + origin_state(ephemeris, origin, "ssb", t)
+    u = np.zeros(t.size)
+    for body in bodies:
+        u += ephemeris.gm(body) / np.linalg.norm(bary[:, :3] - ephemeris.position(body, "ssb", t), axis=1)
+    return (u + 0.5 * np.einsum("ni,ni->n", bary[:, 3:], bary[:, 3:])) / C_LIGHT**2
 
 
 @dataclass

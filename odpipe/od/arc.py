@@ -55,7 +55,8 @@ class ArcSetup:
     stochastic: RTN Gauss-Markov accelerations (m/s^2; tau 0 = white per batch), or None.
     data_sigma: sigma along the line of sight (m or m/s) by "observable:station_rx", else by "observable".
     range_bias_sigma: per pass and receiving station (m; None: no biases; pass_id -1 = one per station).
-    oscillator_sigma: (Hz, Hz/s) of the one-way oscillator bias and drift, when doppler_1way is fitted.
+    oscillator_sigma: (y0, y1 1/s) sigmas of the one-way oscillator's fractional frequency offset and drift,
+    when doppler_1way is fitted (a priori and reference epoch from ``measurements.oscillators``).
     station_sigma: considered (not estimated) error of each station's ITRS coordinates (m per axis).
     media_sigma: considered error of the media calibration scale (fraction of ``media_m``).
     edit_k: innovation k-sigma per iteration (last repeats); reweight: ARTEMIS data reweighting.
@@ -162,9 +163,9 @@ def build_registry(setup: ArcSetup, rows: pd.DataFrame) -> ParameterRegistry:
                 info["pass_id"] = pid
             reg.add(f"bias.range.{st}.pass{pid}", "bias", 0.0, setup.range_bias_sigma, owner=st, **info)
     if setup.oscillator_sigma is not None and (rows["observable"] == "doppler_1way").any():
-        _, bias, drift, _ = setup.measurements.oscillators[sc]
-        reg.add(f"{sc}.osc_bias", "clock", bias, setup.oscillator_sigma[0], owner=sc, oscillator="bias")
-        reg.add(f"{sc}.osc_drift", "clock", drift, setup.oscillator_sigma[1], owner=sc, oscillator="drift")
+        y0, y1, _ = setup.measurements.oscillators[sc]
+        reg.add(f"{sc}.osc_y0", "clock", y0, setup.oscillator_sigma[0], owner=sc, oscillator="y0")
+        reg.add(f"{sc}.osc_y1", "clock", y1, setup.oscillator_sigma[1], owner=sc, oscillator="y1")
     if setup.station_sigma is not None:
         stations = sorted(set(rows["station_rx"]) | set(rows["station_tx"]) - {""})
         for st in stations:

@@ -13,8 +13,8 @@ maneuver        impulsive ICRF dV (``registry.add_maneuver``; owner ``<sc>.<labe
 maneuver_epoch  offset (s) of that maneuver's firing from its logged epoch (``add_maneuver(sigma_epoch=)``);
                 the segment still starts at the logged epoch; reference exact, partials first
                 order in the offset (:mod:`.segment`)
-clock           one-way oscillator: ``info['oscillator']`` 'bias' (Hz) or 'drift' (Hz/s); nominal
-                frequency and reference epoch from ``setup.oscillators[sc]``
+clock           one-way oscillator: ``info['oscillator']`` 'y0' (fractional frequency offset) or 'y1'
+                (its drift, 1/s); the reference epoch from ``setup.oscillators[sc]``
 bias            measurement bias along the line of sight (m for range, m/s for Doppler) of the rows
                 matching ``info`` keys ``observable``, ``station`` (receiver), ``pass_id``, ``spacecraft``
 station         ITRS offset (m) of station ``owner`` from the catalog, ``info['axis']`` x/y/z (linear)
@@ -218,9 +218,9 @@ class TrackingProblem:
         osc = dict(self.setup.oscillators)
         for sc, ix in self._sc.items():
             if ix["oscillator"]:
-                f0, bias, drift, t_ref = self.setup.oscillators[sc]
-                osc[sc] = (f0, x0[ix["oscillator"]["bias"]] if "bias" in ix["oscillator"] else bias,
-                           x0[ix["oscillator"]["drift"]] if "drift" in ix["oscillator"] else drift, t_ref)
+                y0, y1, t_ref = self.setup.oscillators[sc]
+                osc[sc] = (x0[ix["oscillator"]["y0"]] if "y0" in ix["oscillator"] else y0,
+                           x0[ix["oscillator"]["y1"]] if "y1" in ix["oscillator"] else y1, t_ref)
         return replace(self.setup, oscillators=osc)
 
     def _evaluate(self, lo, hi, trajs, x0):
@@ -246,7 +246,7 @@ class TrackingProblem:
             elif p.kind == "media" and "media_scale" in ev.partials:
                 H_lin[:, i] = ev.partials["media_scale"][:, 0]
             elif p.kind == "clock" and f"oscillator:{p.owner}" in ev.partials:
-                H_lin[:, i] = ev.partials[f"oscillator:{p.owner}"][:, ("bias", "drift").index(p.info["oscillator"])]
+                H_lin[:, i] = ev.partials[f"oscillator:{p.owner}"][:, ("y0", "y1").index(p.info["oscillator"])]
         return value, ev.to_los, ev.status, G_x, G_p, H_lin
 
     @staticmethod

@@ -33,6 +33,7 @@ class ArcSection:
 class DataSection:
     files: list[Path]
     stations: list[Path] = field(default_factory=list)  # station CSVs added to the default catalog
+    # observables fitted; "observable:BAND" keeps only rows of that downlink band (e.g. "doppler_1way:X")
     observables: list[str] = field(default_factory=lambda: ["doppler_2way", "range"])
     errors: Literal["raise", "report"] = "report"  # nightly: report a corrupt record and go on
 
@@ -117,6 +118,9 @@ class EstimationSection:
     # LOS sigma (m, m/s) by "observable" or "observable:station" (the station's entry wins)
     data_sigma: dict[str, float] = field(default_factory=lambda: {"range": 2.0, "doppler_2way": 1e-4})
     range_bias_sigma: float | None = 5.0
+    # one-way Doppler's oscillator, estimated when set: sigmas of its fractional frequency offset y0 and drift
+    # y1 (1/s) about the arc start, one pair for every band it drives (a priori 0: the rows' reference)
+    oscillator_sigma: list[float] | None = None
     maneuver_plan: Path | None = None  # planned maneuvers (parsers.maneuvers schema)
     maneuver_epoch_sigma: float | None = None  # s: estimate planned burns' epochs (a plan's sigma_time wins)
     edit_k: list[float] = field(default_factory=lambda: [float("inf"), 10.0, 5.0])

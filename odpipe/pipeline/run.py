@@ -57,6 +57,16 @@ class RunLog:
             self.progress(stamped)
 
 
+def fitted_rows(table: pd.DataFrame, observables: list[str]) -> np.ndarray:
+    """Rows of the configured observables: "observable", or "observable:BAND" for one downlink band."""
+    keep = np.zeros(len(table), bool)
+    for entry in observables:
+        obs, _, band = entry.partition(":")
+        sel = table["observable"].to_numpy() == obs
+        keep |= sel & (table["band_down"].astype(str).to_numpy() == band) if band else sel
+    return keep
+
+
 def run_config(path, *, force: bool = False, progress=print) -> dict:
     """Run the arc of config ``path``; returns ``{"status": "complete" | "skipped", "run": folder, ...}``."""
     cfg = load_config(path)
@@ -115,7 +125,7 @@ def _run(cfg: RunConfig, attempt, log: RunLog) -> dict:
     n_raw = len(table)
     table, creport = compress(table, pre.count_time, ramps=data.ramps, partial=pre.partial, ramp_delay=rtlt)
     log(f"compress: {n_raw} rows -> {len(table)} at {pre.count_time:g} s count time")
-    table = table[table["observable"].isin(cfg.data.observables)].reset_index(drop=True)  # after: counts -> Hz
+    table = table[fitted_rows(table, cfg.data.observables)].reset_index(drop=True)  # after: counts -> Hz
     log(f"observables fitted: {', '.join(f'{k} {v}' for k, v in table['observable'].value_counts().items())}")
     edit_cfg = EditConfig(min_elevation=np.radians(pre.elevation_mask_deg), blunder_k=pre.blunder_k,
                           min_pass_samples=pre.min_pass_samples,

@@ -114,7 +114,8 @@ def arc_setup(cfg: RunConfig, fm: F.ForceModel, ramps, catalog: StationCatalog) 
     state0 = initial_state(cfg, t_state)
     if abs(t_state - start) > 1e-6:  # move the a priori state to the arc start
         state0 = propagate(state0, t_state, start, fm, with_stm=False).state(start)[0]
-    meas = MeasurementSetup(fm.ephemeris, catalog, ramps=ramps, gcrs_to_itrs=gcrs_to_itrs)
+    oscillators = {} if est.oscillator_sigma is None else {cfg.arc.spacecraft: (0.0, 0.0, start)}
+    meas = MeasurementSetup(fm.ephemeris, catalog, ramps=ramps, gcrs_to_itrs=gcrs_to_itrs, oscillators=oscillators)
     stochastic = None if est.stochastic is None else GaussMarkov(est.stochastic.tau, est.stochastic.sigma,
                                                                  est.stochastic.batch)
     return ArcSetup(spacecraft=cfg.arc.spacecraft, start=start, end=end, state0=state0, force_model=fm,
@@ -122,6 +123,7 @@ def arc_setup(cfg: RunConfig, fm: F.ForceModel, ramps, catalog: StationCatalog) 
                     srp_scale_sigma=est.srp_scale_sigma if cfg.dynamics.srp is not None else None,
                     stochastic=stochastic, maneuvers=tuple(maneuver_plans(cfg, fm, state0, start)),
                     data_sigma=dict(est.data_sigma), range_bias_sigma=est.range_bias_sigma,
+                    oscillator_sigma=None if est.oscillator_sigma is None else tuple(est.oscillator_sigma),
                     edit_k=tuple(est.edit_k), max_iter=est.max_iter, reweight=est.reweight,
                     sigma_scale=tuple(est.sigma_scale), block=est.block)
 
