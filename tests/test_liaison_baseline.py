@@ -2,17 +2,17 @@
 range-rate 1 cm/s every 100 s. Paper: the position uncertainty of either satellite
 converges to about one metre within about eight days (values from runs/liaison_baseline.toml)."""
 
-import tomllib
 from pathlib import Path
 
 import numpy as np
 import pandas as pd
 
+from odpipe.liaison.config import load_config
 from odpipe.cli import main
 from odpipe.liaison.baseline import setup
 
 CONFIG = Path(__file__).parents[1] / "runs" / "liaison_baseline.toml"
-CFG = tomllib.loads(CONFIG.read_text())
+CFG = load_config(CONFIG)
 DAY = 86400.0
 
 

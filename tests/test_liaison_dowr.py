@@ -2,12 +2,12 @@
 pseudoranges of eq. 2 computed directly, its partials against finite differences, and a reduced
 run against the paper (clock accuracy of the DOWR mode, DOWR better than one-way ranging)."""
 
-import tomllib
 from pathlib import Path
 
 import numpy as np
 import pytest
 
+from odpipe.liaison.config import load_config
 from odpipe.dynamics.forces import AtmosphericDrag, ForceModel, PointMasses, SolarRadiationPressure
 from odpipe.dynamics.propagator import propagate
 from odpipe.estimation.registry import ParameterRegistry
@@ -20,7 +20,7 @@ from odpipe.measurements.nodes import SpacecraftNode
 from odpipe.time import utc_to_tdb
 
 ROOT = Path(__file__).resolve().parents[1]
-CFG = tomllib.loads((ROOT / "runs/liaison_dowr.toml").read_text())
+CFG = load_config(ROOT / "runs/liaison_dowr.toml")
 EPOCH = np.datetime64(CFG["epoch_utc"], "ns")
 T0 = float(utc_to_tdb(EPOCH))
 

@@ -1,12 +1,12 @@
 """Scenario 4 (Leonard's thesis sec. 8.1): an EML1 halo orbiter and a GEO satellite tracked from
 the ground alone and from the ground plus LiAISON; the thesis' figures as references."""
 
-import tomllib
 from pathlib import Path
 
 import numpy as np
 import pytest
 
+from odpipe.liaison.config import load_config
 from odpipe.dynamics.propagator import propagate
 from odpipe.environment.ephemeris import Ephemeris
 from odpipe.environment.stations import itrs_to_geodetic
@@ -14,7 +14,7 @@ from odpipe.frames.earth import gcrs_to_itrs_state
 from odpipe.liaison import ground
 from odpipe.time import utc_to_tdb
 
-CFG = tomllib.loads((Path(__file__).parents[1] / "runs" / "liaison_ground.toml").read_text())
+CFG = load_config(Path(__file__).parents[1] / "runs" / "liaison_ground.toml")
 CASES = ("ground", "ground_liaison")          # (inf, 0) and (0, 0) of the thesis' Fig. 8.4/8.5
 
 

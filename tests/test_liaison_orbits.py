@@ -4,7 +4,7 @@ import numpy as np
 import pytest
 
 from odpipe.dynamics.crtbp import jacobi_constant, propagate_crtbp
-from odpipe.liaison.orbits import correct_halo, halo_by_period, keplerian_orbit
+from odpipe.liaison.orbits import correct_halo, halo_by_period, halo_start, keplerian_orbit
 
 MU = 0.01215
 
@@ -17,6 +17,18 @@ def test_halo_of_requested_period_closes_after_one_period():
     assert np.allclose(end, s, atol=1e-7)                          # periodic
     assert abs(jacobi_constant(end, MU) - jacobi_constant(s, MU)) < 1e-11
     assert s[2] > 0.1                                               # a halo, not a planar Lyapunov orbit
+
+
+@pytest.mark.parametrize("at,north", [("apolune", True), ("perilune", True), ("apolune", False)])
+def test_halo_start_picks_the_crossing_and_hemisphere(at, north):
+    s, T = halo_by_period(3.30, 1.1137, 0.1953, 0.03, 0.075, MU)       # L2 halo, starts near perilune
+    x = halo_start(s, T, MU, at, north)
+    other = propagate_crtbp(x, 0.0, T / 2, MU, with_stm=False).state(T / 2)[0]
+    moon = np.array([1 - MU, 0, 0])
+    assert (np.linalg.norm(x[:3] - moon) > np.linalg.norm(other[:3] - moon)) == (at == "apolune")
+    assert (x[2] > 0) == north and abs(x[1]) < 1e-9 and abs(x[3]) < 1e-9   # on the x-z plane, crossing it
+    assert np.allclose(propagate_crtbp(x, 0.0, T, MU, with_stm=False).state(T)[0], x, atol=1e-7)
+    assert jacobi_constant(x, MU) == pytest.approx(jacobi_constant(s, MU), abs=1e-10)
 
 
 def test_correct_halo_keeps_the_amplitude():

@@ -5,9 +5,9 @@ from __future__ import annotations
 import importlib
 import json
 import time
-import tomllib
 from pathlib import Path
 
+from odpipe.liaison.config import load_config
 from odpipe.products.atomic import write_text
 
 NAME = "liaison"
@@ -24,7 +24,7 @@ def add_arguments(p):
 
 
 def run(args) -> int:
-    cfg = tomllib.loads(args.config.read_text())
+    cfg = load_config(args.config)
     name = cfg.get("scenario")
     if name not in SCENARIOS:
         raise SystemExit(f"{args.config}: scenario must be one of {SCENARIOS}, got {name!r}")

@@ -8,7 +8,8 @@
 * :mod:`.doppler` - scenario 1b (Fujimoto et al. secs. 3-4: two-way crosslink Doppler, high fidelity);
 * :mod:`.dowr` - scenario 3 (Li et al.: DRO-LEO dual one-way ranging, Table 13);
 * :mod:`.ground` - scenario 4 (Leonard's thesis sec. 8.1: ground tracking with and without LiAISON);
-* :mod:`.report` - tables and convergence plots of a scenario run.
+* :mod:`.report` - tables and convergence plots of a scenario run;
+* :mod:`.config` - scenario configurations (file entries relative to the TOML).
 
 Run with ``odpipe liaison runs/liaison_X.toml -o DIR``.
 """

@@ -84,6 +84,21 @@ def halo_by_period(period: float, x0: float, vy0: float, z_start: float, z_stop:
     return member(brentq(lambda z: member(z)[1] - period, za, zb, xtol=1e-13))
 
 
+def halo_start(state, period: float, mu: float, at: str = "apolune", north: bool = True) -> np.ndarray:
+    """The halo through ``state`` (a y = 0 crossing) started at its x-z crossing farthest from
+    ('apolune') or nearest to ('perilune') the Moon, mirrored so that crossing has z > 0 if
+    ``north`` (z < 0 otherwise)."""
+    if at not in ("apolune", "perilune"):
+        raise ValueError(f"halo start must be 'apolune' or 'perilune', not {at!r}")
+    other = propagate_crtbp(state, 0.0, 0.5 * period, mu, with_stm=False).state(0.5 * period)[0]
+    moon = np.array([1 - mu, 0.0, 0.0])
+    far = np.linalg.norm(state[:3] - moon) > np.linalg.norm(other[:3] - moon)
+    s = np.array(state if far == (at == "apolune") else other, dtype=float)
+    if (s[2] > 0) != north:
+        s[[2, 5]] *= -1
+    return s
+
+
 def keplerian_orbit(period: float, ecc: float, inc: float, mu: float, raan: float = 0.0,
                     argp: float = 0.0, true_anomaly: float = 0.0, primary: str = "moon") -> np.ndarray:
     """Rotating-frame nondimensional state of a Keplerian orbit about 'moon' or 'earth'
