@@ -155,3 +155,17 @@ def test_backward_arc_through_a_maneuver():
     np.testing.assert_allclose(sens[:, 1], (initial(dv + e, tm) - initial(dv - e, tm)) / 2e-3, rtol=1e-6, atol=1e-6)
     fd_t = (initial(dv, tm + 0.01) - initial(dv, tm - 0.01)) / 0.02
     np.testing.assert_allclose(sens[:, 3], fd_t, rtol=1e-5, atol=1e-6)
+
+
+def test_fixed_steps_are_eighth_order():
+    """rtol = inf: steps of exactly max_step; the error after one orbit falls as h^8 (Kepler)."""
+    fm = ForceModel("earth", central_gm=GM)
+    t1 = 8640.0
+    errs = []
+    for h in (480.0, 240.0):
+        traj = propagate(X0, 0.0, t1, fm, with_stm=False, rtol=np.inf, max_step=h)
+        assert traj.n_steps == t1 / h
+        errs.append(np.linalg.norm(traj.state(t1)[0][:3] - kepler(X0, t1)[:3]))
+    print("fixed-step errors (m)", errs, "ratio", errs[0] / errs[1])
+    assert errs[1] > 1e-6                                          # still truncation error, not round-off
+    assert 2**6 < errs[0] / errs[1] < 2**10                        # 8th order: 2^8 per halving

@@ -5,7 +5,8 @@ published DOP853 constants (Hairer, Norsett & Wanner, Solving ODE I), taken
 from scipy's coefficient table so they are typed nowhere here. The step-size
 controller and 3/5-order error norm follow Hairer's DOP853. The error norm
 covers the first ``n_err`` components only (the state; the variational part
-rides on the same steps).
+rides on the same steps). ``rtol = inf`` takes fixed steps of ``h_max`` (the last one
+shorter to land on t1) without error control, the way onboard filters integrate.
 
 ``integrate(model, t0, y0, t1, rtol, atol, h_max, n_err)`` -> (t (k+1,),
 y (k+1, n), F (k, 7, n), n_eval). The right-hand side is ``derivative(t, y,
@@ -97,8 +98,9 @@ def integrate(model, t0, y0, t1, rtol, atol, h_max, n_err):
         d1 += (K[0, i] / sc) ** 2
     d0 = np.sqrt(d0 / n_err)
     d1 = np.sqrt(d1 / n_err)
+    fixed = rtol == np.inf                       # fixed steps of h_max, no error control
     h_abs = 1e-6 if (d0 < 1e-5 or d1 < 1e-5) else 0.01 * d0 / d1
-    h_abs = min(h_abs, h_max, span)
+    h_abs = min(h_max if fixed else h_abs, h_max, span)
     while True:
         remaining = abs(t1 - t)
         if remaining <= 1e-12 * max(1.0, abs(t1)):
@@ -117,7 +119,7 @@ def integrate(model, t0, y0, t1, rtol, atol, h_max, n_err):
         t_new = t + h if h_abs < remaining else t1
         derivative(t_new, y_new, model, K[N_STAGES])
         n_eval += N_STAGES
-        err = _error_norm(K, h, y, y_new, rtol, atol, n_err)
+        err = 0.0 if fixed else _error_norm(K, h, y, y_new, rtol, atol, n_err)
         if err > 1.0:
             h_abs *= max(MIN_FACTOR, SAFETY * err ** (-1.0 / 8.0))
             if h_abs < 1e-10 * max(1.0, abs(t)):

@@ -37,7 +37,8 @@ def propagate(state0, t0: float, t1: float, force_model: ForceModel, with_stm: b
     """Integrate ``state0`` (m, m/s, ICRF, relative to ``force_model.center``) from t0 to t1 (TDB s).
 
     ``params``: dynamic parameters to carry sensitivities for (default: all of the
-    model's when ``with_stm``). ``rtol``/``atol`` (m and m/s) control the state error.
+    model's when ``with_stm``). ``rtol``/``atol`` (m and m/s) control the state error;
+    ``rtol = inf`` integrates with fixed steps of ``max_step`` instead (8th order, no error control).
     """
     params = list(force_model.parameter_names() if params is None and with_stm else (params or []))
     if params and not with_stm:

@@ -52,9 +52,9 @@ class SegmentTrajectory:
     """Reference trajectory of one spacecraft over ``[a - lookback, b]`` (TDB s)."""
 
     def __init__(self, x_start, a, b, force_model, params, dv=None, lookback=120.0,
-                 rtol=1e-12, atol=1e-6, dt=None):
+                 rtol=1e-12, atol=1e-6, dt=None, max_step=np.inf):
         """``dv``: ICRF dV (m/s) of a burn at ``a``; ``dt``: its estimated firing offset (s; None: not
-        estimated, the burn is at ``a``)."""
+        estimated, the burn is at ``a``); ``rtol``, ``atol``, ``max_step``: as :func:`propagate`."""
         if dt is not None and dv is None:
             raise ValueError("an epoch offset needs the maneuver's dV")
         self.center = force_model.center
@@ -67,18 +67,17 @@ class SegmentTrajectory:
         self._dv = None if dv is None else np.asarray(dv, float).copy()
         self._dt = None if dt is None else float(dt)
         x_plus = self.x_start.copy()
+        tol = dict(rtol=rtol, atol=atol, max_step=max_step)
         if self._dt:
             t_fire = a + self._dt
-            x_fire = propagate(self.x_start, a, t_fire, force_model, with_stm=False, rtol=rtol,
-                               atol=atol).state(t_fire)[0]
+            x_fire = propagate(self.x_start, a, t_fire, force_model, with_stm=False, **tol).state(t_fire)[0]
             x_fire[3:6] += self._dv
-            x_plus = propagate(x_fire, t_fire, a, force_model, with_stm=False, rtol=rtol, atol=atol).state(a)[0]
+            x_plus = propagate(x_fire, t_fire, a, force_model, with_stm=False, **tol).state(a)[0]
         elif dv is not None:
             x_plus[3:6] += self._dv
-        self._fwd = propagate(x_plus, a, b, force_model, with_stm=True, params=list(params),
-                              rtol=rtol, atol=atol)
+        self._fwd = propagate(x_plus, a, b, force_model, with_stm=True, params=list(params), **tol)
         self._back = propagate(self.x_start, a, a - lookback, force_model, with_stm=True,
-                               params=list(params), rtol=rtol, atol=atol)
+                               params=list(params), **tol)
         self.n_eval = self._fwd.n_eval + self._back.n_eval
         self._memo: dict = {float(a): (self.x_start, np.eye(6), np.eye(6), np.zeros((6, len(self.param_names))))}
 
