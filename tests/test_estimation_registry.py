@@ -71,3 +71,13 @@ def test_stochastic_groups_one_per_process():
     groups = reg.stochastic_groups()
     assert [list(g[0]) for g in groups] == [[6, 7, 8], [20, 21, 22]]
     assert groups[1][1].tau == 0.0
+
+
+def test_stochastic_accelerations_with_one_sigma_per_axis():
+    reg = ParameterRegistry()
+    reg.add_stochastic_acceleration("leo", [1e-5, 1e-6, 1e-5], 0.0, 60.0)      # seed 003 Table 11, R/T/N
+    sig = [reg.parameters[i].sigma for i in reg.indices("stochastic")]
+    assert sig == [1e-5, 1e-6, 1e-5]
+    groups = reg.stochastic_groups()                                        # equal sigmas share a process
+    assert sorted(list(g[0]) for g in groups) == [[0, 2], [1]]
+    assert sorted(g[1].sigma for g in groups) == [1e-6, 1e-5]

@@ -95,11 +95,13 @@ class ParameterRegistry:
 
     def add_stochastic_acceleration(self, spacecraft, sigma, tau, batch,
                                     axes=("R", "T", "N")):
-        """Gauss-Markov accelerations (m/s^2) on each axis (RTN by default)."""
-        proc = GaussMarkov(tau, sigma, batch)
-        for a in axes:
-            self.add(f"{spacecraft}.acc_{a}", "stochastic", 0.0, sigma,
-                     owner=spacecraft, process=proc, axis=a)
+        """Gauss-Markov accelerations (m/s^2) on each axis (RTN by default); ``sigma`` one value
+        or one per axis (axes of equal sigma share one process)."""
+        sigmas = [float(s) for s in np.broadcast_to(np.asarray(sigma, float), (len(axes),))]
+        procs = {s: GaussMarkov(tau, s, batch) for s in sigmas}
+        for a, s in zip(axes, sigmas):
+            self.add(f"{spacecraft}.acc_{a}", "stochastic", 0.0, s,
+                     owner=spacecraft, process=procs[s], axis=a)
 
     def add_maneuver(self, spacecraft, label, epoch, sigma_dv=0.01,
                      designed=(0.0, 0.0, 0.0), sigma_epoch=None):
