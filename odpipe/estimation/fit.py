@@ -77,7 +77,8 @@ class FitOptions:
     unconverged with the post-fit RMS above diverged_rms sigma and above its best iteration's.
 
     tol_dx: converged (at the last stage) when every epoch correction < tol_dx sigma and
-    the post-fit RMS changed by < tol_rms (relative); extra_epochs: more grid epochs (TDB s);
+    the post-fit RMS changed by < tol_rms (relative; in sigma below an RMS of 1, where noise
+    absorbed by process noise leaves changes of 1e-4 sigma that mean nothing); extra_epochs: more grid epochs (TDB s);
     output_at_measurements: put every observation time on the grid, so filtered and
     smoothed estimates exist at each measurement time."""
 
@@ -251,7 +252,7 @@ def fit(problem: Problem, obs: Observations, t_start: float, t_end: float,
                 step_p[(k, j)] = dx[k][idx]
                 p_after[(k, j)] = ps.refs[k][idx] + dx[k][idx]
         last_step, halvings = (step_x, step_p), 0
-        rms_ok = prev_rms is not None and abs(rms - prev_rms) <= options.tol_rms * prev_rms
+        rms_ok = prev_rms is not None and abs(rms - prev_rms) <= options.tol_rms * max(prev_rms, 1.0)
         prev_rms = rms
         if options.reweight and stage == last_stage:
             for g in groups:
