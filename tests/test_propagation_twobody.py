@@ -169,3 +169,19 @@ def test_fixed_steps_are_eighth_order():
     print("fixed-step errors (m)", errs, "ratio", errs[0] / errs[1])
     assert errs[1] > 1e-6                                          # still truncation error, not round-off
     assert 2**6 < errs[0] / errs[1] < 2**10                        # 8th order: 2^8 per halving
+
+
+def test_rk4_is_fourth_order_and_its_dense_output_is_hermite():
+    fm = ForceModel("earth", central_gm=GM)
+    t1 = 8640.0
+    errs = []
+    for h in (120.0, 60.0):
+        traj = propagate(X0, 0.0, t1, fm, with_stm=True, method="rk4", max_step=h)
+        assert traj.n_steps == t1 / h
+        errs.append(np.linalg.norm(traj.state(t1)[0][:3] - kepler(X0, t1)[:3]))
+    print("RK4 errors (m)", errs, "ratio", errs[0] / errs[1])
+    assert 2**3 < errs[0] / errs[1] < 2**5                         # 4th order: 2^4 per halving
+    mid = traj.state(t1 - 30.0)[0]                                 # between two step ends
+    assert np.linalg.norm(mid[:3] - kepler(X0, t1 - 30.0)[:3]) < 2 * errs[1] + 1e-3
+    with pytest.raises(ValueError, match="rk4"):
+        propagate(X0, 0.0, t1, fm, method="rk4")                  # needs a step

@@ -15,6 +15,7 @@ from typing import Mapping, Sequence
 import numpy as np
 
 from odpipe.dynamics.dop853 import integrate
+from odpipe.dynamics.rk4 import integrate_rk4
 from odpipe.dynamics.forces import ForceModel, compile_model
 from odpipe.dynamics.rhs import acceleration  # also registers the orbit right-hand side
 from odpipe.dynamics.trajectory import Trajectory, TrajectorySet
@@ -33,13 +34,16 @@ def _state_derivative(t, r, v, model):
 
 def propagate(state0, t0: float, t1: float, force_model: ForceModel, with_stm: bool = True,
               params: Sequence[str] | None = None, rtol: float = 1e-12, atol: float = 1e-9,
-              max_step: float = np.inf) -> Trajectory:
+              max_step: float = np.inf, method: str = "dop853") -> Trajectory:
     """Integrate ``state0`` (m, m/s, ICRF, relative to ``force_model.center``) from t0 to t1 (TDB s).
 
     ``params``: dynamic parameters to carry sensitivities for (default: all of the
     model's when ``with_stm``). ``rtol``/``atol`` (m and m/s) control the state error;
-    ``rtol = inf`` integrates with fixed steps of ``max_step`` instead (8th order, no error control).
+    ``rtol = inf`` integrates with fixed steps of ``max_step`` instead (8th order, no error control);
+    ``method = 'rk4'``: classical Runge-Kutta with fixed steps of ``max_step``.
     """
+    if method not in ("dop853", "rk4") or (method == "rk4" and not np.isfinite(max_step)):
+        raise ValueError(f"method must be 'dop853' or 'rk4' (with a finite max_step), not {method!r}")
     params = list(force_model.parameter_names() if params is None and with_stm else (params or []))
     if params and not with_stm:
         raise ValueError("parameter sensitivities need with_stm=True")
@@ -63,7 +67,9 @@ def propagate(state0, t0: float, t1: float, force_model: ForceModel, with_stm: b
     for t_b in cuts + [t1]:
         model[1][5] = 0.5 * (t_a + t_b)
         try:
-            ts, ys, Fs, ne = integrate(model, float(t_a), y, float(t_b), rtol, atol, max_step, 6)
+            ts, ys, Fs, ne = (integrate_rk4(model, float(t_a), y, float(t_b), float(max_step), 6)
+                              if method == "rk4" else
+                              integrate(model, float(t_a), y, float(t_b), rtol, atol, max_step, 6))
         except RuntimeError as err:
             raise IntegrationError(f"{err} between TDB {t_a:.3f} and {t_b:.3f} s, starting "
                                    f"{np.linalg.norm(y[:3]) / 1e3:.3f} km from {force_model.center}") from err

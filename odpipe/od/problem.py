@@ -84,13 +84,14 @@ class TrackingProblem:
     maneuvers and stochastic accelerations: the problem adds them);
     lookback: s before a segment start covered for light time and count intervals;
     epochs: where transitions will be asked (the filter grid), evaluated per segment in one pass;
-    fixed_step: spacecraft id -> fixed integration step (s, 8th order without error control, as an
-    onboard filter integrates); the others integrate adaptively to ``rtol``/``atol``.
+    integrator: spacecraft id -> :func:`propagate` settings overriding ``rtol``/``atol`` (fixed steps
+    as an onboard filter takes them: ``{"rtol": inf, "max_step": 60}``, or ``{"method": "rk4",
+    "max_step": 60}``).
     """
 
     def __init__(self, registry, rows: pd.DataFrame, times: np.ndarray, force_models: dict,
                  setup: MeasurementSetup, t_start: float, t_end: float, lookback: float = 120.0,
-                 rtol: float = 1e-12, atol: float = 1e-6, epochs=(), fixed_step=None):
+                 rtol: float = 1e-12, atol: float = 1e-6, epochs=(), integrator=None):
         self.registry = registry
         self.rows = rows.reset_index(drop=True)
         self.times = np.asarray(times, float)
@@ -99,7 +100,7 @@ class TrackingProblem:
         self.force_models, self.setup = dict(force_models), setup
         self.t_start, self.t_end = float(t_start), float(t_end)
         self.lookback, self.rtol, self.atol = lookback, rtol, atol
-        self.fixed_step = dict(fixed_step or {})
+        self.integrator = dict(integrator or {})
         self.epochs = np.asarray(epochs, float)
         self.n_propagations = 0
         self._segments: list[_Segment] = []
@@ -200,10 +201,8 @@ class TrackingProblem:
             dt_idx = ix["maneuver_epochs"].get(a)
             dv = x0[dv_idx] if dv_idx is not None else None
             dt = x0[dt_idx] if dt_idx is not None else None
-            step = self.fixed_step.get(sc)
-            trajs[sc] = SegmentTrajectory(x0[ix["state"]], a, b, fm, names, dv, self.lookback,
-                                          self.rtol if step is None else np.inf, self.atol, dt=dt,
-                                          max_step=np.inf if step is None else step)
+            settings = {"rtol": self.rtol, "atol": self.atol, **self.integrator.get(sc, {})}
+            trajs[sc] = SegmentTrajectory(x0[ix["state"]], a, b, fm, names, dv, self.lookback, dt=dt, **settings)
             trajs[sc].preload(self.epochs[(self.epochs > a) & (self.epochs <= b)])
             pidx[sc] = np.array(idx + (dv_idx or []) + ([dt_idx] if dt_idx is not None else []), int)
             self.n_propagations += 1

@@ -52,9 +52,10 @@ class SegmentTrajectory:
     """Reference trajectory of one spacecraft over ``[a - lookback, b]`` (TDB s)."""
 
     def __init__(self, x_start, a, b, force_model, params, dv=None, lookback=120.0,
-                 rtol=1e-12, atol=1e-6, dt=None, max_step=np.inf):
+                 rtol=1e-12, atol=1e-6, dt=None, **integrator):
         """``dv``: ICRF dV (m/s) of a burn at ``a``; ``dt``: its estimated firing offset (s; None: not
-        estimated, the burn is at ``a``); ``rtol``, ``atol``, ``max_step``: as :func:`propagate`."""
+        estimated, the burn is at ``a``); ``rtol``, ``atol`` and ``integrator`` (``max_step``,
+        ``method``): as :func:`propagate`."""
         if dt is not None and dv is None:
             raise ValueError("an epoch offset needs the maneuver's dV")
         self.center = force_model.center
@@ -67,7 +68,7 @@ class SegmentTrajectory:
         self._dv = None if dv is None else np.asarray(dv, float).copy()
         self._dt = None if dt is None else float(dt)
         x_plus = self.x_start.copy()
-        tol = dict(rtol=rtol, atol=atol, max_step=max_step)
+        tol = dict(rtol=rtol, atol=atol, **integrator)
         if self._dt:
             t_fire = a + self._dt
             x_fire = propagate(self.x_start, a, t_fire, force_model, with_stm=False, **tol).state(t_fire)[0]
