@@ -3,13 +3,15 @@ high-fidelity dynamics.
 
 Truth: Earth-centred ICRF states of Table 1 at 2020-01-01 (UTC), point masses of the
 Sun, Moon and planets (DE440; the paper: DE405) and a 20x20 Earth field on the GEO
-satellite (GGM05S here; the paper: GGM02C). Filter: Sun, Moon and a 5x5 Earth field,
+satellite (GGM02C, as the paper). Filter: Sun, Moon and a 5x5 Earth field,
 white RTN accelerations over 1000-s batches as state-noise compensation
 (Q = 4e-14 (m/s^2)^2 per axis, eqs. 10-11), one constant Doppler bias, the
 initial deviations of Table 3. Data: :func:`odpipe.measurements.compute`
 'sst_doppler' (round-trip path change over the count time, light time solved),
 every 1000 s for 19.9957 d, white noise and a constant bias, rows with the link
-through the Earth removed. The fit is odpipe's iterated filter-smoother over
+through the Earth removed and, as in the paper, no tracking while the GEO satellite's
+|v_x| < 1500 m/s (``filter.geo_cutoff_vx_mps``; v_x of the truth, the paper's estimate is
+within cm/s of it). The fit is odpipe's iterated filter-smoother over
 :class:`odpipe.od.problem.TrackingProblem`; accuracy = truth - filtered, RMS over
 the last half of the arc per axis (Tables 4-5).
 """
@@ -36,6 +38,23 @@ from .report import plot_convergence, write_markdown, write_table
 DAY = 86400.0
 R_EARTH = 6378136.3
 NAMES = ("L1", "GEO")
+DIFFERENCES = """\
+- Filter: odpipe's iterated square-root information filter-smoother, relinearized about the smoothed
+  solution on growing arcs (``stage_days``), not one EKF pass; accuracy is truth minus the forward
+  filter of the last iteration, as the paper's is truth minus its EKF's estimate.
+- What limits the accuracy: the paper's S- and X-band accuracies are nearly equal (L1 293 and 296 m)
+  although the Doppler noise differs 10x, so its accuracy is not set by the data noise; it names
+  growing numerical integration errors as what spoils its bias estimate. odpipe integrates to 1e-12
+  (relative), and its X-band errors are 2-2.4x below its S-band ones, as noise-limited estimates are.
+- State-noise compensation: Q = 4e-14 (m/s^2)^2 per axis as white accelerations held over each 1000-s
+  data interval. With one Doppler point per interval they absorb much of the noise: post-fit residuals
+  are 0.76 sigma (S) and 0.06 sigma (X); the paper's X-band post-fit RMS, 2.03e-5 m/s, is 0.2 sigma.
+- GEO cut-off: no data while the GEO satellite's |v_x| < 1500 m/s (the paper: "absolute velocity in
+  the x-direction ... less than 1500 m/s"), taken from the truth rather than the estimate.
+- Not given in the paper, chosen here: the count time (60 s), the bias a priori (1 mm/s on the line
+  of sight), the a priori of Table 1 read as variances (100 m, 0.1 m/s), the noise draws (``seed``).
+- Models: DE440 (paper DE405); GGM02C, as the paper.
+"""
 
 
 def force_models(cfg, eph, which: str) -> dict:
@@ -81,6 +100,10 @@ def run(cfg: dict, out, log=print) -> dict:
     epochs = np.arange(start + step, start + np.timedelta64(int(cfg["arc_days"] * DAY * 1e9), "ns"), step)
     t_rx = np.asarray(utc_to_tdb(epochs), float)
     clear = link_clear(truth["L1"].state(t_rx)[:, :3], truth["GEO"].state(t_rx)[:, :3])
+    cutoff = cfg["filter"].get("geo_cutoff_vx_mps", 0.0)
+    tracked = clear & (np.abs(truth["GEO"].state(t_rx)[:, 3]) >= cutoff)
+    log(f"{clear.sum()} of {clear.size} epochs with a clear link, {tracked.sum()} with GEO |vx| >= {cutoff} m/s")
+    clear = tracked
     rows = _rows(epochs[clear], cfg).reset_index(drop=True)
     times = t_rx[clear]
     ev = compute(rows, truth, meas)
@@ -124,12 +147,13 @@ def run(cfg: dict, out, log=print) -> dict:
     notes = "\n".join(f"- {band}: bias {r['bias']:.3e} +- {r['bias_sigma']:.1e} m/s (truth "
                       f"{cfg['band'][band]['bias_mps']}), post-fit residual RMS {r['postfit_rms']:.3e} m/s "
                       f"(paper X-band: {cfg['paper']['X']['postfit_rms_mps']}), {int(clear.sum())} of "
-                      f"{clear.size} epochs with a clear link, converged {r['converged']}"
+                      f"{clear.size} epochs tracked (link clear of the Earth, GEO |v_x| >= "
+                      f"{cfg['filter'].get('geo_cutoff_vx_mps', 0.0)} m/s), converged {r['converged']}"
                       for band, r in results.items())
     write_markdown(out, "LiAISON scenario 1b: GEO + EML1 halo, two-way crosslink Doppler (Fujimoto et al. secs. 3-4)",
                    [("Tables 4-5: accuracy RMS over the last half, paper vs odpipe",
                      write_table(out, "tables45", table) + "\n![convergence](convergence.png)\n"),
-                    ("Fit", notes + "\n")])
+                    ("Fit", notes + "\n"), ("Differences from the paper's set-up", DIFFERENCES)])
     return {"table": table}
 
 
