@@ -22,6 +22,18 @@ def _one(trial, rng, index):
     return trial(rng, index)
 
 
+def parallel_map(fn: Callable, *iterables, parallel: bool = False, n_workers: int | None = None) -> list:
+    """[fn(*args) for args in zip(*iterables)], in order; on a ``dask.distributed.LocalCluster``
+    (processes, ``n_workers`` default: the CPU count) when ``parallel`` (``fn`` picklable)."""
+    if not parallel:
+        return [fn(*args) for args in zip(*iterables)]
+    from dask.distributed import Client, LocalCluster
+
+    with LocalCluster(n_workers=n_workers, threads_per_worker=1, processes=True,
+                      dashboard_address=":0") as cluster, Client(cluster) as client:
+        return client.gather(client.map(fn, *iterables, pure=False))
+
+
 def monte_carlo(trial: Callable[[np.random.Generator, int], Any], n_runs: int, seed: int = 0,
                 parallel: bool = False, n_workers: int | None = None) -> list:
     """[trial(rng_i, i) for i in range(n_runs)], in run order.
@@ -29,15 +41,8 @@ def monte_carlo(trial: Callable[[np.random.Generator, int], Any], n_runs: int, s
     ``parallel``: map the runs on a ``dask.distributed.LocalCluster`` (processes,
     ``n_workers`` default: the CPU count); ``trial`` must then be picklable.
     """
-    rngs = run_generators(seed, n_runs)
-    if not parallel:
-        return [trial(rng, i) for i, rng in enumerate(rngs)]
-    from dask.distributed import Client, LocalCluster
-
-    with LocalCluster(n_workers=n_workers, threads_per_worker=1, processes=True,
-                      dashboard_address=":0") as cluster, Client(cluster) as client:
-        futures = client.map(_one, [trial] * n_runs, rngs, range(n_runs), pure=False)
-        return client.gather(futures)
+    return parallel_map(_one, [trial] * n_runs, run_generators(seed, n_runs), range(n_runs),
+                        parallel=parallel, n_workers=n_workers)
 
 
 def rms_over_runs(errors: np.ndarray) -> np.ndarray:

@@ -61,7 +61,9 @@ def plot_convergence(out: Path, name: str, panels: list[dict], ylabel: str, ncol
         ax.grid(True, which="both", alpha=0.3)
     for row in axes:
         row[0].set_ylabel(ylabel)
-    axes[0][-1].legend(fontsize=7)
+    axes.ravel()[min(ncols, len(panels)) - 1].legend(fontsize=7)
+    for ax in axes.ravel()[len(panels):]:
+        ax.set_visible(False)
     fig.tight_layout()
     path = Path(out) / f"{name}.png"
     with atomic_path(path) as tmp:
