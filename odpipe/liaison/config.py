@@ -2,7 +2,8 @@
 
 Entries named ``*_file`` or ``*_gravity`` (at any depth) hold paths; a relative one is taken
 from the configuration's folder, so ``runs/liaison_*.toml`` point at ``../../shared/data``
-and run from any working directory.
+and run from any working directory. ``base = "other.toml"`` starts from that configuration:
+tables merge key by key, everything else (values, lists, arrays of tables) is replaced.
 """
 
 from __future__ import annotations
@@ -18,7 +19,20 @@ def _resolve(node, base: Path):
     return node
 
 
-def load_config(path) -> dict:
-    """The scenario configuration at ``path`` with its file entries resolved."""
-    path = Path(path)
-    return _resolve(tomllib.loads(path.read_text()), path.resolve().parent)
+def _merge(base: dict, over: dict) -> dict:
+    out = dict(base)
+    for k, v in over.items():
+        out[k] = _merge(out[k], v) if isinstance(v, dict) and isinstance(out.get(k), dict) else v
+    return out
+
+
+def load_config(path, _seen=()) -> dict:
+    """The scenario configuration at ``path`` on its ``base``, file entries resolved."""
+    path = Path(path).resolve()
+    if path in _seen:
+        raise ValueError(f"{path}: configuration bases form a cycle")
+    cfg = _resolve(tomllib.loads(path.read_text()), path.parent)
+    if "base" not in cfg:
+        return cfg
+    base = load_config(path.parent / cfg.pop("base"), (*_seen, path))
+    return _merge(base, cfg)
