@@ -70,9 +70,12 @@ DIFFERENCES = """\
   solution on growing arcs (``stage_days``), not one EKF pass. The filtered accuracy once converged is
   comparable; the early transients of an EKF started 1 km off (the paper's divergence to 3 km and 30 km
   in Simu. 8, Fig. 19) are absent, so convergence times where observability is poor come out shorter.
-- Process noise: the paper's sigma per 60-s step becomes white RTN accelerations held over ``batch_s``
-  with the same velocity-variance rate; the DRO clock offset gets a random walk of the truth's level
-  (the paper holds its clock parameters constant in the time update).
+- Process noise: the paper's sigma per integration step (60 s, or the study's step) becomes white RTN
+  accelerations held over ``batch_s`` with the same velocity-variance rate, so Simu. 4's 1e-8 m/s^2
+  per 5-min step gives the DRO 22x Simu. 2's; the DRO clock offset gets a random walk of the truth's
+  level (the paper holds its clock parameters constant in the time update).
+- Simu. 9: the paper does not say how DOWR and one-way passes alternate; here every other 12-h pass
+  is DOWR.
 - Models: DE440 (paper DE405), GGM02C (GGM01C) and LP165P (GL0120B); what matters is the truth-minus-
   filter truncation (70 -> 50 and 20 -> 15 in Model-B), which is kept.
 - Not given in the paper, chosen here: the LEO time error's correlation time, the clock a0, the delay,
