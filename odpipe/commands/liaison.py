@@ -13,7 +13,7 @@ from odpipe.products.atomic import write_text
 NAME = "liaison"
 HELP = "LiAISON crosslink navigation scenario (runs/liaison_*.toml): tables beside the paper's, plots"
 
-SCENARIOS = ("turan", "baseline", "doppler", "dowr", "ground")  # modules of odpipe.liaison
+SCENARIOS = ("turan", "baseline", "doppler", "dowr", "ground", "ground_mesh")  # modules of odpipe.liaison
 
 
 def add_arguments(p):

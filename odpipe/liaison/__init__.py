@@ -8,6 +8,7 @@
 * :mod:`.doppler` - scenario 1b (Fujimoto et al. secs. 3-4: two-way crosslink Doppler, high fidelity);
 * :mod:`.dowr` - scenario 3 (Li et al.: DRO-LEO dual one-way ranging, Table 13);
 * :mod:`.ground` - scenario 4 (Leonard's thesis sec. 8.1: ground tracking with and without LiAISON);
+* :mod:`.ground_mesh` - its trade study (Fig. 8.4 mesh of schedules, Fig. 8.9 scheduling offset);
 * :mod:`.report` - tables and convergence plots of a scenario run;
 * :mod:`.config` - scenario configurations (file entries relative to the TOML).
 

@@ -174,11 +174,13 @@ def scheduled(t_rel: np.ndarray, gap_h: float, pass_h: float) -> np.ndarray:
 
 
 def case_rows(cfg, rows: pd.DataFrame, case: dict, t0: float) -> pd.DataFrame:
-    """The rows a schedule {liaison_gap_h, ground_gap_h} uses."""
+    """The rows a schedule {liaison_gap_h, ground_gap_h[, ground_offset_h]} uses (the ground passes
+    start ``ground_offset_h`` after the epoch, sec. 8.1.2.4; 0 by default)."""
     t_rel = rows["time"].to_numpy() - t0
     sst = (rows["link"] == "sst").to_numpy()
+    t_ground = t_rel - 3600.0 * case.get("ground_offset_h", 0.0)
     keep = np.where(sst, scheduled(t_rel, case["liaison_gap_h"], cfg["pass_h"]),
-                    scheduled(t_rel, case["ground_gap_h"], cfg["pass_h"]))
+                    (t_ground >= 0) & scheduled(t_ground, case["ground_gap_h"], cfg["pass_h"]))
     return rows[keep].reset_index(drop=True)
 
 
@@ -272,9 +274,9 @@ def bias_summary(cfg, res: dict) -> str:
                                  f"{np.sqrt(sol.smoothed_P[0, k, k]):.2f}" for n, k in ks.items())
 
 
-def run(cfg: dict, out, log=print) -> dict:
-    """Simulate, fit every case of cfg['cases'] and write report.md, cases.csv and the plots into ``out``;
-    returns the table, per case {solution, registry, metrics, rows} and the true epoch states."""
+def prepare(cfg: dict, log=print) -> dict:
+    """Truth, every candidate row with its noise, the a priori draws and the filter's force models:
+    {setup, t0, t1, x0, truth, rows, guess, fm}."""
     setup = MeasurementSetup.default()
     setup.stations = station_catalog(cfg)
     start = np.datetime64(cfg["epoch_utc"], "ns")
@@ -288,7 +290,16 @@ def run(cfg: dict, out, log=print) -> dict:
     rows = observe(cfg, tracking_rows(cfg, truth, setup, start), rng)
     guess = initial_guess(cfg, x0, rng)
     log(f"truth and {len(rows)} candidate rows; biases {rows.attrs['bias']}")
-    fm = force_models(cfg, setup.ephemeris, "filter")
+    return {"setup": setup, "t0": t0, "t1": t1, "x0": x0, "truth": truth, "rows": rows, "guess": guess,
+            "fm": force_models(cfg, setup.ephemeris, "filter")}
+
+
+def run(cfg: dict, out, log=print) -> dict:
+    """Simulate, fit every case of cfg['cases'] and write report.md, cases.csv and the plots into ``out``;
+    returns the table, per case {solution, registry, metrics, rows} and the true epoch states."""
+    sim = prepare(cfg, log)
+    setup, t0, t1, x0, truth, rows, guess, fm = (sim[k] for k in ("setup", "t0", "t1", "x0", "truth", "rows",
+                                                                   "guess", "fm"))
     table, sigmas, panels, results = [], {sc: [] for sc in NAMES}, [], {}
     sens = cfg["sensitivity"]
     scaled = dict(cfg, filter=dict(cfg["filter"], acc_sigma_rtn=[sens["acc_scale"] * a
