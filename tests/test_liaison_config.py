@@ -40,3 +40,9 @@ def test_the_integrator_study_runs_on_the_dowr_set_up():
     base, study = load_config(RUNS / "liaison_dowr.toml"), load_config(RUNS / "liaison_dowr_integrators.toml")
     assert study["scenario"] == "dowr" and study["clock"] == base["clock"]
     assert [s["name"] for s in study["simulation"]] == ["Simu. 1", "Simu. 3", "Simu. 4", "Simu. 5"]
+
+
+def test_malformed_toml_names_the_file_and_line(tmp_path):
+    (tmp_path / "bad.toml").write_text('seed = 1\n[clock\na0 = 1.0\n')
+    with pytest.raises(ValueError, match=r"bad\.toml.*line 2"):
+        load_config(tmp_path / "bad.toml")

@@ -31,7 +31,10 @@ def load_config(path, _seen=()) -> dict:
     path = Path(path).resolve()
     if path in _seen:
         raise ValueError(f"{path}: configuration bases form a cycle")
-    cfg = _resolve(tomllib.loads(path.read_text()), path.parent)
+    try:
+        cfg = _resolve(tomllib.loads(path.read_text()), path.parent)
+    except tomllib.TOMLDecodeError as err:
+        raise ValueError(f"{path}: {err}") from err
     if "base" not in cfg:
         return cfg
     base = load_config(path.parent / cfg.pop("base"), (*_seen, path))

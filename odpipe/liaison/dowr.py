@@ -29,7 +29,9 @@ position components stay below 100 m.
 
 from __future__ import annotations
 
+import json
 from dataclasses import replace
+from functools import lru_cache
 from pathlib import Path
 
 import numpy as np
@@ -365,17 +367,16 @@ def _truth(cfg) -> tuple:
     return meas, t0, t1, x0, truth
 
 
-_TRUTH: dict = {}
+@lru_cache(maxsize=1)
+def _truth_of(setup_json: str) -> tuple:
+    """:func:`_truth` once per process and set-up (the configuration without its simulations, as JSON)."""
+    return _truth(json.loads(setup_json))
 
 
 def simulation(cfg: dict, sim: dict, log=print) -> dict:
     """One simulation of Table 13: data, fit and accuracy (the truth is made once per process)."""
-    key = repr(sorted((k, repr(v)) for k, v in cfg.items() if k != "simulation"))
-    if key not in _TRUTH:
-        _TRUTH.clear()
-        _TRUTH[key] = _truth(cfg)
-        log("truth propagated")
-    meas, t0, t1, x0, truth = _TRUTH[key]
+    meas, t0, t1, x0, truth = _truth_of(json.dumps({k: v for k, v in cfg.items() if k != "simulation"},
+                                                   sort_keys=True))
     rng = np.random.default_rng(cfg["seed"])        # the same truth noise and a priori draws for every run
     clocks = ClockTruth(cfg["clock"], t0, t1, rng)
     rows, times = simulate(cfg, meas, truth, clocks, sim["plan"], rng)

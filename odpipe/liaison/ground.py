@@ -218,6 +218,15 @@ def fit_case(cfg, setup, rows: pd.DataFrame, guess: dict, fm: dict, t0: float, t
     return fit(prob, obs, t0, t1, opts), reg
 
 
+def fit_schedule(cfg, sim: dict, case: dict, cfg_fit=None) -> dict:
+    """One schedule on the :func:`prepare` set-up ``sim`` (filter settings of ``cfg_fit``, default
+    ``cfg``): {solution, registry, metrics, rows}."""
+    rows = case_rows(cfg, sim["rows"], case, sim["t0"])
+    sol, reg = fit_case(cfg_fit or cfg, sim["setup"], rows, sim["guess"], sim["fm"], sim["t0"], sim["t1"])
+    return {"solution": sol, "registry": reg, "rows": rows,
+            "metrics": position_metrics(sol, sim["truth"], sim["t0"], cfg["window_days"])}
+
+
 def position_metrics(sol, truth: dict, t0: float, window_days, level_m: float = 100.0) -> dict:
     """Per spacecraft: filtered 3-D error and 3-sigma (m) on the grid, their RMS over the window,
     the final 3-sigma, the day after which the 3-sigma stays below ``level_m`` and the mean
@@ -298,8 +307,7 @@ def run(cfg: dict, out, log=print) -> dict:
     """Simulate, fit every case of cfg['cases'] and write report.md, cases.csv and the plots into ``out``;
     returns the table, per case {solution, registry, metrics, rows} and the true epoch states."""
     sim = prepare(cfg, log)
-    setup, t0, t1, x0, truth, rows, guess, fm = (sim[k] for k in ("setup", "t0", "t1", "x0", "truth", "rows",
-                                                                   "guess", "fm"))
+    t0, rows = sim["t0"], sim["rows"]
     table, sigmas, panels, results = [], {sc: [] for sc in NAMES}, [], {}
     sens = cfg["sensitivity"]
     scaled = dict(cfg, filter=dict(cfg["filter"], acc_sigma_rtn=[sens["acc_scale"] * a
@@ -307,10 +315,8 @@ def run(cfg: dict, out, log=print) -> dict:
     runs = [(name, case, cfg) for name, case in cfg["cases"].items()]
     runs += [(f"{name} (acc x{sens['acc_scale']:g})", cfg["cases"][name], scaled) for name in sens["cases"]]
     for name, case, cfg_fit in runs:
-        sel = case_rows(cfg, rows, case, t0)
-        sol, reg = fit_case(cfg_fit, setup, sel, guess, fm, t0, t1)
-        m = position_metrics(sol, truth, t0, cfg["window_days"])
-        results[name] = {"solution": sol, "registry": reg, "metrics": m, "rows": sel}
+        results[name] = fit_schedule(cfg, sim, case, cfg_fit)
+        sol, m, sel = results[name]["solution"], results[name]["metrics"], results[name]["rows"]
         log(f"{name}: {len(sel)} rows, {len(sol.history)} iterations, post-fit RMS "
             f"{sol.history[-1]['postfit_rms']:.3f} (whitened), converged {sol.converged}; "
             + ", ".join(f"{sc} 3-sigma {m[sc]['rms_sig3']:.1f} m error {m[sc]['rms_err']:.1f} m" for sc in NAMES))
@@ -340,4 +346,4 @@ def run(cfg: dict, out, log=print) -> dict:
                     ("Differences from the thesis", cfg["report"]["differences"] + "\n"),
                     ("Fits", notes + "\n\nTrue range biases (m): "
                      + ", ".join(f"{k} {v:.2f}" for k, v in rows.attrs["bias"].items()) + "\n")])
-    return {"table": df, "results": results, "x0": x0}
+    return {"table": df, "results": results, "x0": sim["x0"]}

@@ -17,15 +17,14 @@ import pandas as pd
 
 from odpipe.products.atomic import atomic_path
 
-from .ground import NAMES, case_rows, fit_case, position_metrics, prepare
+from .ground import NAMES, fit_schedule, prepare
 from .report import plot_convergence, write_markdown, write_table
 
 
 def _fit(cfg, sim, case) -> dict:
-    rows = case_rows(cfg, sim["rows"], case, sim["t0"])
-    sol, _ = fit_case(cfg, sim["setup"], rows, sim["guess"], sim["fm"], sim["t0"], sim["t1"])
-    m = position_metrics(sol, sim["truth"], sim["t0"], cfg["window_days"])
-    return {**case, "rows": len(rows), "converged": sol.converged,
+    r = fit_schedule(cfg, sim, case)
+    m = r["metrics"]
+    return {**case, "rows": len(r["rows"]), "converged": r["solution"].converged,
             **{f"{sc} {k}": m[sc][k] for sc in NAMES for k in ("rms_sig3", "rms_err")}}
 
 
