@@ -77,6 +77,8 @@ def read(path, errors: str = "raise", spacecraft: str = "") -> TrackingData:
 def _line(f: Fields) -> list[tuple]:
     """(epoch, observable, value, unit, station, two_way, line) for each value of one measurement line."""
     f.need(3, "epoch, type, station")
+    if not _EPOCH.fullmatch(f.str(0)):
+        raise f.error(f"epoch {f.str(0)!r} is not ISO-8601 YYYY-MM-DDThh:mm:ss[.s]")
     kind = f.str(1)
     if kind not in TYPES:
         raise f.error(f"unknown measurement type {kind!r} (expected one of {', '.join(TYPES)})")
@@ -84,8 +86,6 @@ def _line(f: Fields) -> list[tuple]:
     f.record = kind
     if len(f) != 3 + n:
         raise f.error(f"{kind} needs {3 + n} fields (epoch, type, station, {n} value(s)), found {len(f)}")
-    if not _EPOCH.fullmatch(f.str(0)):
-        raise f.error(f"epoch {f.str(0)!r} is not ISO-8601 YYYY-MM-DDThh:mm:ss[.s]")
     try:
         epoch = np.datetime64(f.str(0).rstrip("Z"), "ns")
     except ValueError:
