@@ -29,7 +29,7 @@ import numpy as np
 
 from parsers import table as tt
 from parsers.errors import ParseError, ParseReport, check_mode, handle
-from parsers.fields import Fields
+from parsers.fields import Fields, numbered_lines
 from parsers.table import TrackingData
 
 # type -> (number of values, [(observable, unit, scale to SI), ...] one per value, two-way)
@@ -53,7 +53,7 @@ def read(path, errors: str = "raise", spacecraft: str = "") -> TrackingData:
     path = Path(path)
     report = ParseReport()
     rows = []
-    for number, text in enumerate(path.read_text(encoding="latin-1").splitlines(), start=1):
+    for number, text in numbered_lines(path):
         if not text.strip() or text.lstrip().startswith("#"):
             continue
         try:

@@ -29,7 +29,7 @@ import numpy as np
 import pandas as pd
 
 from parsers.errors import ParseError, ParseReport, check_mode, handle
-from parsers.fields import Fields, date_ns
+from parsers.fields import Fields, numbered_lines, date_ns
 
 FRAMES = {0: "ITRF", 1: "TOD", 2: "EME2000"}
 MJD0 = np.datetime64("1858-11-17", "ns")
@@ -65,7 +65,7 @@ def read(path, errors: str = "raise") -> Cpf:
     report = ParseReport()
     header, rows, comments = {}, [], []
     ended = False
-    for number, text in enumerate(path.read_text(encoding="latin-1").splitlines(), start=1):
+    for number, text in numbered_lines(path):
         if not text.strip():
             continue
         kind = text[:2].upper()

@@ -68,7 +68,7 @@ import pandas as pd
 
 from parsers import table as tt
 from parsers.errors import ParseError, ParseReport, check_mode, handle
-from parsers.fields import Fields, date_ns
+from parsers.fields import Fields, numbered_lines, date_ns
 from parsers.table import TrackingData
 
 C_LIGHT = 299_792_458.0  # m/s
@@ -228,7 +228,7 @@ def read(path, errors: str = "raise") -> TrackingData:
     path = Path(path)
     report = ParseReport()
     r = _Reader(path, errors, report)
-    for number, text in enumerate(path.read_text(encoding="latin-1").splitlines(), start=1):
+    for number, text in numbered_lines(path):
         if not text.strip():
             continue
         try:

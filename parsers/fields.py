@@ -17,6 +17,19 @@ MISSING = ("na", "NA")  # CRD/CPF v2 writes "na" for a value not available
 _DECIMAL = re.compile(r"\d+(\.\d*)?|\.\d+")
 
 
+def numbered_lines(path):
+    """(1-based line number, text without its line end) of a text file, lines ended by LF or CR LF only.
+
+    Read as latin-1, so every byte is one character and no character (such as
+    U+0085 from a UTF-8 byte) starts a line the way ``str.splitlines`` would.
+    """
+    text = open(path, encoding="latin-1", newline="").read()
+    lines = text.split("\n")
+    if lines and lines[-1] == "":
+        lines.pop()
+    return [(k, ln[:-1] if ln.endswith("\r") else ln) for k, ln in enumerate(lines, start=1)]
+
+
 class Fields:
     """The fields of line ``number`` (1-based) of ``path``: ``text.split()`` unless ``fields`` are given."""
 

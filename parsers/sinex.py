@@ -16,6 +16,9 @@ fixed-column lines (``*`` starts a comment). Read here (columns 1-based):
   components 47-54, 56-63, 65-72 (m) from the marker to the instrument
   reference point.
 
+A number may spill into the blank column before it (ILRS files write
+``-51.5480-118.8670``): value columns are read from that blank column on.
+
 Epochs ``YY:DDD:SSSSS`` (YY <= 50 -> 20YY; a four-digit year is read as is) are
 UTC datetime64[ns]; ``00:000:00000`` (unspecified) is NaT.
 :func:`stations` combines positions, velocities and reference epochs per
@@ -32,7 +35,7 @@ import numpy as np
 import pandas as pd
 
 from parsers.errors import ParseError, ParseReport, check_mode, handle
-from parsers.fields import Fields
+from parsers.fields import Fields, numbered_lines
 
 # block -> [(column name, first col, last col (1-based, inclusive), kind)]; kind s text, f float, i int, e epoch
 BLOCKS = {
@@ -43,10 +46,10 @@ BLOCKS = {
                         ("start", 17, 28, "e"), ("end", 30, 41, "e"), ("mean", 43, 54, "e")],
     "SOLUTION/ESTIMATE": [("index", 2, 6, "i"), ("type", 8, 13, "s"), ("code", 15, 18, "s"), ("point", 20, 21, "s"),
                           ("soln", 23, 26, "s"), ("ref_epoch", 28, 39, "e"), ("unit", 41, 44, "s"),
-                          ("constraint", 46, 46, "s"), ("value", 48, 68, "f"), ("std", 70, 80, "f")],
+                          ("constraint", 46, 46, "s"), ("value", 47, 68, "f"), ("std", 69, 80, "f")],
     "SITE/ECCENTRICITY": [("code", 2, 5, "s"), ("point", 7, 8, "s"), ("soln", 10, 13, "s"),
                           ("technique", 15, 15, "s"), ("start", 17, 28, "e"), ("end", 30, 41, "e"),
-                          ("system", 43, 45, "s"), ("e1", 47, 54, "f"), ("e2", 56, 63, "f"), ("e3", 65, 72, "f")],
+                          ("system", 43, 45, "s"), ("e1", 46, 54, "f"), ("e2", 55, 63, "f"), ("e3", 64, 72, "f")],
 }
 ESTIMATE_TYPES = {"STAX": "x_m", "STAY": "y_m", "STAZ": "z_m", "VELX": "vx_m_per_yr", "VELY": "vy_m_per_yr",
                   "VELZ": "vz_m_per_yr"}
@@ -127,7 +130,7 @@ def read(path, errors: str = "raise") -> Sinex:
     check_mode(errors)
     path = Path(path)
     report = ParseReport()
-    lines = path.read_text(encoding="latin-1").splitlines()
+    lines = [text for _, text in numbered_lines(path)]
     if not lines or not sniff(lines[0].encode("latin-1")):
         raise ParseError(path, "not a SINEX file (first line does not start with %=SNX)", line=1)
     rows: dict[str, list] = {}
