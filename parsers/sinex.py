@@ -106,17 +106,18 @@ class Sinex:
         out = out.merge(sites, on=["code", "point"], how="left")
         out[["x_m", "y_m", "z_m"]] = out[["x_m", "y_m", "z_m"]].astype(float)
         if at is not None:
-            t = np.datetime64(at, "ns")
-            rows = [_holding(g, t) for _, g in out.groupby(["code", "point"])]
-            out = pd.DataFrame([r for r in rows if r is not None]).reset_index(drop=True)
-        return out
+            out = out[_holds(out, np.datetime64(at, "ns"))].drop_duplicates(["code", "point"], keep="last")
+        return out.reset_index(drop=True)
+
+
+def _holds(rows: pd.DataFrame, t: np.datetime64) -> pd.Series:
+    """Mask of ``rows`` whose [start, end] holds ``t`` (NaT bounds are open)."""
+    return (rows["start"].isna() | (rows["start"] <= t)) & (rows["end"].isna() | (t <= rows["end"]))
 
 
 def _holding(rows: pd.DataFrame, t: np.datetime64):
-    """The last of ``rows`` whose [start, end] holds ``t`` (NaT bounds are open), or None."""
-    start = rows["start"].fillna(pd.Timestamp.min)
-    end = rows["end"].fillna(pd.Timestamp.max)
-    hit = rows[(start <= t) & (t <= end)]
+    """The last of ``rows`` whose [start, end] holds ``t``, or None."""
+    hit = rows[_holds(rows, t)]
     return hit.iloc[-1] if len(hit) else None
 
 
