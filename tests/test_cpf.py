@@ -110,3 +110,14 @@ def test_v2_header_velocities_and_end_record(tmp_path):
     p.write_text(p.read_text() + "10 0 60370  43440.0  0   1.0 2.0 3.0\n")
     with pytest.raises(ParseError, match="line 10, record 10: record after the 99"):
         cpf.read(p)
+
+
+@pytest.mark.realdata
+def test_inspect_describes_and_convert_refuses_a_cpf(shared_data, tmp_path, capsys):
+    from odpipe.cli import main
+
+    assert main(["inspect", str(shared_data / FULL)]) == 0
+    out = capsys.readouterr().out
+    assert "format: parsers.cpf" in out and "frame: ITRF" in out and "positions: 288" in out
+    assert main(["convert", str(shared_data / FULL), "-o", str(tmp_path / "x.parquet")]) == 1
+    assert "is not tracking data" in capsys.readouterr().out

@@ -196,3 +196,16 @@ H9
     with pytest.raises(ParseError, match="line 29, record H1: record after the H9"):
         p.write_text(text + "H1 CRD  2 2024 03 01 12\n")
         crd.read(p)
+
+
+@pytest.mark.realdata
+def test_inspect_and_convert_know_crd(shared_data, tmp_path, capsys):
+    from odpipe.cli import main
+    from odpipe.preprocess import store
+
+    assert main(["inspect", str(shared_data / NPT)]) == 0
+    out = capsys.readouterr().out
+    assert "format: parsers.crd" in out and "observable: range 95" in out and "passes: 11" in out
+    assert main(["convert", str(shared_data / NPT), "-o", str(tmp_path / "l2.parquet")]) == 0
+    table, _ = store.read(tmp_path / "l2.parquet")
+    assert len(table) == 95 and table["tof_s"].iloc[0] == 0.048208768002

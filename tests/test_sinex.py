@@ -126,3 +126,12 @@ def test_corrupted_copies_name_file_and_line(shared_data, tmp_path):
         sinex.read(_copy(shared_data, tmp_path, SLRF, 1, "%=XYZ"))
     with pytest.raises(ParseError, match=r"line 2162: -SOLUTION/ESTIMATE closes no open block"):
         sinex.read(_copy(shared_data, tmp_path, SLRF, 822, "*+SOLUTION/ESTIMATE"))
+
+
+@pytest.mark.realdata
+def test_inspect_describes_a_sinex_file(shared_data, capsys):
+    from odpipe.cli import main
+
+    assert main(["inspect", str(shared_data / SLRF)]) == 0
+    out = capsys.readouterr().out
+    assert "format: parsers.sinex" in out and "SOLUTION/ESTIMATE: 1338 lines" in out and "unreadable lines: 0" in out
