@@ -71,7 +71,8 @@ def read(path, errors: str = "raise", spacecraft: str = "") -> TrackingData:
                      station_tx=np.where(t(two_way), t(station), "").astype(object),
                      station_rx=t(station).astype(object), spacecraft=spacecraft, source=str(path),
                      record=t(line) - 1, flags=0, line=t(line))
-    return TrackingData(table=table, ramps=tt.empty_ramps(), report=report, meta={"stations": sorted(set(station.tolist()))})
+    return TrackingData(table=table, ramps=tt.empty_ramps(), report=report,
+                        meta={"stations": sorted(set(station.tolist()))})
 
 
 def _line(f: Fields) -> list[tuple]:

@@ -89,7 +89,8 @@ SPEC = {
               "pulse_width_ps:f divergence_arcsec:f pulses_in_train:i"),
     "C2": (13, "detail_type:i config_id:s detector_type:s wavelength_nm:f quantum_efficiency_pct:f voltage_v:f "
                "dark_count_khz:f output_pulse_type:s output_pulse_width_ps:f filter_nm:f filter_transmission_pct:f "
-               "spatial_filter_arcsec:f signal_processing:s amplifier_gain:f amplifier_bandwidth_khz:f amplifier_in_use:s"),
+               "spatial_filter_arcsec:f signal_processing:s amplifier_gain:f amplifier_bandwidth_khz:f "
+               "amplifier_in_use:s"),
     "C3": (7, "detail_type:i config_id:s time_source:s frequency_source:s timer:s timer_serial:s epoch_delay_us:f"),
     "C4": (10, "detail_type:i config_id:s station_utc_offset_ns:f station_drift:f transponder_utc_offset_ns:f "
                "transponder_drift:f transponder_ref_time_s:f station_offset_applied:i sc_offset_applied:i "
@@ -151,8 +152,8 @@ def decode(f: Fields, kind: str) -> dict:
 class _Reader:
     """State of one pass over the file: current headers, the open session, the records gathered."""
 
-    def __init__(self, path: Path, errors: str, report: ParseReport):
-        self.path, self.errors, self.report = path, errors, report
+    def __init__(self, path: Path):
+        self.path = path
         self.h1 = self.h2 = self.h3 = None
         self.session = None          # dict of the open session (H4 .. H8)
         self.sessions, self.configuration, self.ranges = [], [], []
@@ -204,7 +205,7 @@ class _Reader:
             raise f.error(f"H4 session header before any {', '.join(m.upper() for m in missing)} record")
         rec = decode(f, "H4")
         self.session = {"session": len(self.sessions), "line": f.number, "format_version": self.h1["version"],
-                        **{k: v for k, v in self.h2.items()}, **self.h3, **rec}
+                        **self.h2, **self.h3, **rec}
         self.sessions.append(self.session)
 
     def _need_session(self, f: Fields) -> dict:
@@ -227,7 +228,7 @@ def read(path, errors: str = "raise") -> TrackingData:
     check_mode(errors)
     path = Path(path)
     report = ParseReport()
-    r = _Reader(path, errors, report)
+    r = _Reader(path)
     for number, text in numbered_lines(path):
         if not text.strip():
             continue
@@ -292,15 +293,17 @@ def _table(rows: list[dict], sessions: pd.DataFrame, config: pd.DataFrame, meteo
     downlink = two_way | np.isin(event, (4, 6))
     pressure, temperature, humidity = _meteo_at(epoch, df["session"].to_numpy(), meteo)
     out = tt.build(
-        len(df), epoch=epoch, tag=tag.astype(object), observable=np.where(two_way, "range", "range_1way").astype(object),
+        len(df), epoch=epoch, tag=tag.astype(object),
+        observable=np.where(two_way, "range", "range_1way").astype(object),
         value=np.where(two_way, C_LIGHT / 2, C_LIGHT) * tof, unit="m", count_time=0.0,
-        station_tx=np.where(uplink, station, "").astype(object), station_rx=np.where(downlink, station, "").astype(object),
+        station_tx=np.where(uplink, station, "").astype(object),
+        station_rx=np.where(downlink, station, "").astype(object),
         spacecraft=s["target"].astype(str).to_numpy(object), source=source,
         record=df["line"].to_numpy(np.int64) - 1, flags=0,
         tof_s=tof, epoch_event=event, epoch_file=t, system_id=df["system_id"].astype(str).to_numpy(object),
         wavelength_nm=_wavelengths(df, config), station_code=s["station_code"].astype(str).to_numpy(object),
         session=df["session"].to_numpy(np.int64), line=df["line"].to_numpy(np.int64),
-        window_s=df.get("window_s", pd.Series(np.nan, df.index)).fillna(np.nan).to_numpy(float),
+        window_s=df.get("window_s", pd.Series(np.nan, df.index)).to_numpy(float),
         n_raw=df.get("n_raw", pd.Series(-1, df.index)).fillna(-1).to_numpy(np.int64),
         bin_rms_ps=df.get("bin_rms_ps", pd.Series(np.nan, df.index)).to_numpy(float),
         validity=(df.get("filter_flag", pd.Series(-1, df.index)).fillna(-1).to_numpy(np.int64) == 1).astype(np.int64),
