@@ -55,7 +55,7 @@ class Cpf:
 def sniff(head: bytes) -> bool:
     """True when the first non-blank line is an H1 record of format CPF."""
     first = next((ln for ln in head.decode("latin-1").splitlines() if ln.strip()), "")
-    return first[:2].upper() == "H1" and first[2:].split()[:1] in (["CPF"], ["cpf"])
+    return first[:2].upper() == "H1" and [w.upper() for w in first[2:].split()[:1]] == ["CPF"]
 
 
 def read(path, errors: str = "raise") -> Cpf:

@@ -123,7 +123,7 @@ _FIELDS = {rt: [tuple(f.split(":")) for f in names.split()] for rt, (_, names) i
 def sniff(head: bytes) -> bool:
     """True when the first non-blank line is an H1 record of format CRD."""
     first = next((ln for ln in head.decode("latin-1").splitlines() if ln.strip()), "")
-    return first[:2].upper() == "H1" and first[2:].split()[:1] in (["CRD"], ["crd"])
+    return first[:2].upper() == "H1" and [w.upper() for w in first[2:].split()[:1]] == ["CRD"]
 
 
 def decode(f: Fields, kind: str) -> dict:

@@ -52,10 +52,12 @@ class Fields:
         return self.fields[i] if i < len(self.fields) else default
 
     def int(self, i: int, name: str, default: int | None = None) -> int:
-        """Field ``i`` as an integer; ``default`` when the line ends before it (None: required)."""
+        """Field ``i`` as an integer ('na' -> -1); ``default`` when the line ends before it (None: required)."""
         text = self._get(i, name, default)
         if not isinstance(text, str):
             return text
+        if text in MISSING:
+            return -1
         try:
             return int(text)
         except ValueError:

@@ -151,7 +151,7 @@ C7 0 cal target 100.123 1.0 0.0 0.0 0.5 prc 1.0
 20 86399.9 1001.00 281.00 60.0 0
 21 86300.0 1.0 90.0 clear 10.0 0.5 2 1 na
 30 86300.0 123.4567 45.6789 0 1 1 0.01 0.02
-40 86250.0 0 sys 100 90 10.000 2000.0 1.0 20.0 0.1 -0.1 5.0 2 2 0 60 50.0
+40 86250.0 0 sys na 90 10.000 2000.0 1.0 20.0 0.1 -0.1 5.0 2 2 0 60 50.0
 41 86260.0 0 sys 100 90 10.000 2001.0 1.0 20.0 0.1 -0.1 5.0 2 2 0 60 50.0
 11 86390.000000000001 0.040000000000 sys 2 30.0 100 20.0 0.1 -0.2 -1.0 50.0 0 12.5
 11 10.500000000000 0.030000000000 sys 0 30.0 100 20.0 0.1 -0.2 -1.0 50.0 0 na
@@ -189,6 +189,7 @@ H9
     assert np.isnan(m["meteo_supplements"].iloc[0]["sky_temperature_k"])
     assert m["supplements"].iloc[0][["com_correction_m", "range_rate_mps"]].tolist() == [0.251, 1234.5]
     assert len(m["calibrations"]) == 2 and m["calibrations"]["span"].tolist() == [60, 60]
+    assert m["calibrations"]["n_recorded"].tolist() == [-1, 100]                  # "na": not available
     assert m["comments"].iloc[0]["text"] == "a comment"
     c = m["configuration"].set_index("record")
     assert np.isnan(c.loc["C1", "divergence_arcsec"]) and c.loc["C2", "amplifier_in_use"] == "1"
