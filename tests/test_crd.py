@@ -211,3 +211,50 @@ def test_inspect_and_convert_know_crd(shared_data, tmp_path, capsys):
     assert main(["convert", str(shared_data / NPT), "-o", str(tmp_path / "l2.parquet")]) == 0
     table, _ = store.read(tmp_path / "l2.parquet")
     assert len(table) == 95 and table["tof_s"].iloc[0] == 0.048208768002
+
+
+@pytest.mark.realdata
+def test_normal_points_close_on_the_cpf_through_the_troposphere(shared_data, npt):
+    """Observed range minus the CPF's geometric range, at the reception times this reader gives.
+
+    The CPF (ITRF, 300 s, 10-point Lagrange) turned to GCRS, light time solved both legs, SLRF2014 stations
+    moved by their ILRS eccentricities: what is left is the optical troposphere (about 2.4 mm per hPa at the
+    zenith, over sin(elevation)) less LAGEOS-2's 0.251 m centre-of-mass offset (Orekit's
+    range.center.of.mass.correction), to within the prediction's error. A time tag at transmission would leave
+    200 m, a missing eccentricity (3.18 m up at 7090) over 1 m.
+    """
+    from scipy.interpolate import BarycentricInterpolator
+
+    from odpipe.environment.stations import StationCatalog, topocentric
+    from odpipe.frames.earth import itrs_to_gcrs
+    from parsers import cpf
+
+    d = shared_data / "orekit_od/Lageos2"
+    pos = cpf.read(d / "lageos2_cpf_160213_5441.sgf").positions
+    tc, xyz = pos["epoch"].to_numpy().astype(np.int64) / 1e9, pos[["x_m", "y_m", "z_m"]].to_numpy()
+    cat = StationCatalog.default().with_sinex(d / "SLRF2014_POS+VEL_2030.0_200428.snx", "2016-02-13T16:00",
+                                              eccentricities=d / "ecc_une.snx")
+
+    def sat_gcrs(t):
+        k = min(max(np.searchsorted(tc, t.astype(np.int64) / 1e9) - 5, 0), len(tc) - 10)
+        r = BarycentricInterpolator(tc[k:k + 10], xyz[k:k + 10])(t.astype(np.int64) / 1e9)
+        return itrs_to_gcrs(np.array([t]))[0] @ r, r
+
+    inside = (npt.table["epoch"] > pos["epoch"].iloc[0] + pd.Timedelta("30min")) & \
+        (npt.table["epoch"] < pos["epoch"].iloc[-1] - pd.Timedelta("30min"))
+    rows = npt.table[inside]
+    assert len(rows) == 49 and set(rows["station_code"]) == {"YARL", "HA4T", "MATM"}
+    left = []
+    for r in rows.itertuples():
+        t3 = np.datetime64(r.epoch, "ns")
+        st = cat[r.station_rx]
+        r_st = st.position_itrs(np.array([t3]))[0]
+        before = lambda s: t3 - np.timedelta64(int(round(s * 1e9)), "ns")  # noqa: E731
+        down = up = r.tof_s / 2
+        for _ in range(3):
+            sat, sat_itrf = sat_gcrs(before(down))
+            down = np.linalg.norm(sat - itrs_to_gcrs(np.array([t3]))[0] @ r_st) / C
+            up = np.linalg.norm(sat - itrs_to_gcrs(np.array([before(down + up)]))[0] @ r_st) / C
+        _, el, _ = topocentric(st, sat_itrf, t3)
+        left.append((r.value - C * (up + down) / 2) * np.sin(el) - 2.4e-3 * r.pressure_mbar + 0.251)
+    assert np.abs(left).max() < 0.3                                     # m, at the zenith
