@@ -31,11 +31,18 @@ def numbered_lines(path):
 
 
 class Fields:
-    """The fields of line ``number`` (1-based) of ``path``: ``text.split()`` unless ``fields`` are given."""
+    """The fields of line ``number`` (1-based) of ``path``: ``text.split()`` unless ``fields`` are given.
 
-    def __init__(self, path, number: int, text: str, record: str = "", fields: list[str] | None = None):
-        self.path, self.number, self.text, self.record = path, number, text, record
+    ``fixed``: the fields were cut from columns and their names say which (messages then omit "field i").
+    """
+
+    def __init__(self, path, number: int, text: str, record: str = "", fields: list[str] | None = None,
+                 fixed: bool = False):
+        self.path, self.number, self.text, self.record, self.fixed = path, number, text, record, fixed
         self.fields = text.split() if fields is None else fields
+
+    def _label(self, i: int, name: str) -> str:
+        return name if self.fixed else f"field {i + 1} ({name})"
 
     def __len__(self) -> int:
         return len(self.fields)
@@ -61,7 +68,7 @@ class Fields:
         try:
             return int(text)
         except ValueError:
-            raise self.error(f"field {i + 1} ({name}) must be an integer, not {text!r}") from None
+            raise self.error(f"{self._label(i, name)} must be an integer, not {text!r}") from None
 
     def float(self, i: int, name: str, default: float | None = None) -> float:
         """Field ``i`` as a float ('na' -> NaN; Fortran D exponents allowed); ``default`` when absent."""
@@ -73,16 +80,16 @@ class Fields:
         try:
             value = float(text.replace("D", "E").replace("d", "e"))
         except ValueError:
-            raise self.error(f"field {i + 1} ({name}) must be a number, not {text!r}") from None
+            raise self.error(f"{self._label(i, name)} must be a number, not {text!r}") from None
         if math.isnan(value) or math.isinf(value):
-            raise self.error(f"field {i + 1} ({name}) must be a finite number, not {text!r}")
+            raise self.error(f"{self._label(i, name)} must be a finite number, not {text!r}")
         return value
 
     def seconds_ns(self, i: int, name: str) -> int:
         """Field ``i``, a non-negative decimal number of seconds, as exact integer nanoseconds."""
         text = self._get(i, name, None)
         if not _DECIMAL.fullmatch(text):
-            raise self.error(f"field {i + 1} ({name}) must be non-negative decimal seconds, not {text!r}")
+            raise self.error(f"{self._label(i, name)} must be non-negative decimal seconds, not {text!r}")
         whole, _, frac = text.partition(".")
         digits = (frac + "0" * 10)[:10]  # one digit beyond ns, to round
         return int(whole or 0) * 1_000_000_000 + (int(digits) + 5) // 10
@@ -91,7 +98,7 @@ class Fields:
         if i < len(self.fields):
             return self.fields[i]
         if default is None:
-            raise self.error(f"field {i + 1} ({name}) is missing: {self.text.strip()!r}")
+            raise self.error(f"{self._label(i, name)} is missing: {self.text.strip()!r}")
         return default
 
 

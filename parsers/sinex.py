@@ -151,7 +151,7 @@ def read(path, errors: str = "raise") -> Sinex:
             break
         elif block in BLOCKS and text.strip() and not text.startswith("*"):
             try:
-                rows.setdefault(block, []).append(_row(Fields(path, number, text, record=block, fields=[]), block))
+                rows.setdefault(block, []).append(_row(Fields(path, number, text, record=block, fields=[], fixed=True), block))
             except ParseError as err:
                 handle(err, errors, report)
     else:
