@@ -65,7 +65,8 @@ class Sinex:
     report: ParseReport = field(default_factory=ParseReport)
 
     def block(self, name: str) -> pd.DataFrame:
-        return self.blocks.get(name, pd.DataFrame(columns=[c[0] for c in BLOCKS[name]] + ["line"]))
+        columns = [c[0] + ("_deg" if c[3] == "a" else "") for c in BLOCKS[name]] + ["line"]
+        return self.blocks.get(name, pd.DataFrame(columns=columns))
 
     @property
     def eccentricities(self) -> pd.DataFrame:
