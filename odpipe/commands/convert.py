@@ -32,7 +32,11 @@ def load(path, errors: str = "raise") -> TrackingData:
 
 
 def run(args) -> int:
-    data = load(args.input, args.errors)
+    try:
+        data = load(args.input, args.errors)
+    except (OSError, ValueError) as exc:  # ParseError is a ValueError; so is a file that holds no tracking data
+        print(f"error: {exc}")
+        return 1
     suffix = Path(args.output).suffix.lower()
     if suffix == ".parquet":
         written = store.write(args.output, data.table, data.ramps)
