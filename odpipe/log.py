@@ -28,6 +28,18 @@ class _Format(logging.Formatter):
         return msg
 
 
+class _Stderr(logging.StreamHandler):
+    """A handler writing to whatever ``sys.stderr`` is when a record comes (a test may have swapped it)."""
+
+    @property
+    def stream(self):
+        return sys.stderr
+
+    @stream.setter
+    def stream(self, _):
+        pass
+
+
 def level(verbosity: int) -> int:
     """The logging level of a verbosity (-v count minus -q count)."""
     return {1: logging.DEBUG, 0: logging.INFO, -1: logging.WARNING}.get(max(-2, min(1, verbosity)), logging.ERROR)
@@ -35,11 +47,11 @@ def level(verbosity: int) -> int:
 
 def configure(verbosity: int = 0, stream=None) -> None:
     """Send the odpipe and parsers loggers' records at ``level(verbosity)`` and above to ``stream``
-    (default: the current ``sys.stderr``). Calling again replaces the previous set-up."""
+    (default: ``sys.stderr``). Calling again replaces the previous set-up."""
     root = logging.getLogger()
     while _installed:
         root.removeHandler(_installed.pop())
-    handler = logging.StreamHandler(stream or sys.stderr)
+    handler = logging.StreamHandler(stream) if stream is not None else _Stderr()
     handler.setFormatter(_Format())
     root.addHandler(handler)
     _installed.append(handler)

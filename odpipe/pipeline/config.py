@@ -64,8 +64,9 @@ def _recognised(path: Path, readers: tuple[str, ...], what: str) -> str | None:
 
 
 def _files_of(readers: tuple[str, ...], what: str):
-    """Check: every path of a list is a readable file of one of ``readers``."""
-    return lambda paths: [("", why) for p in paths if (why := _recognised(p, readers, what))]
+    """Check: a path (or every path of a list) is a readable file of one of ``readers``."""
+    return lambda paths: [("", why) for p in (paths if isinstance(paths, list) else [paths])
+                          if (why := _recognised(p, readers, what))]
 
 
 @dataclass
