@@ -33,8 +33,11 @@ MEANING = {
 _INPUT_OS_ERRORS = (FileNotFoundError, PermissionError, IsADirectoryError, NotADirectoryError)
 
 
-def describe(exc: BaseException) -> tuple[Exit, str]:
-    """The exit status an error gives and its one-line message."""
+DEBUG_HINT = "rerun with --debug for the traceback"
+
+
+def describe(exc: BaseException, hint: str = DEBUG_HINT) -> tuple[Exit, str]:
+    """The exit status an error gives and its one-line message (``hint``: where a bug's traceback is)."""
     fit = sys.modules.get("odpipe.estimation.fit")  # not imported: no fit ran (and importing it takes seconds)
     text = " ".join(str(exc).split())
     if fit is not None and isinstance(exc, fit.FitDiverged):
@@ -44,5 +47,4 @@ def describe(exc: BaseException) -> tuple[Exit, str]:
         return (Exit.INPUT if isinstance(exc, _INPUT_OS_ERRORS) else Exit.INTERNAL), f"{where}{exc.strerror}"
     if isinstance(exc, ValueError) and text:  # ParseError and ConfigError are ValueErrors that name the place
         return Exit.INPUT, text
-    return Exit.INTERNAL, (f"internal error ({type(exc).__name__}: {text or repr(exc)}); this is a bug: "
-                           "rerun with --debug for the traceback")
+    return Exit.INTERNAL, f"internal error ({type(exc).__name__}: {text or repr(exc)}); this is a bug: {hint}"

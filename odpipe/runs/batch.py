@@ -35,6 +35,10 @@ class BatchSection:
     report: Path | None = None  # folder of the night's report (residual statistics, overlaps)
     overlaps: list[Path] | None = None  # arcs whose consecutive overlaps are reported (default: all)
 
+    def problems(self):
+        if not self.arcs:
+            yield "arcs", "lists no run configuration"
+
 
 @dataclass
 class BatchConfig:
@@ -66,7 +70,8 @@ def _guarded(run_one: Callable[[Path], dict], config: str, *after: ArcOutcome) -
         detail = run_one(Path(config)) or {}
         return ArcOutcome(config, detail.get("status", "complete"), time.perf_counter() - t0, detail)
     except Exception as exc:  # one arc's failure is reported, never fatal to the batch
-        return ArcOutcome(config, "failed", time.perf_counter() - t0, error=describe(exc)[1])
+        return ArcOutcome(config, "failed", time.perf_counter() - t0,
+                          error=describe(exc, hint=f"`odpipe --debug run {config}` shows the traceback")[1])
 
 
 def dependency_order(configs: list[str], after: dict) -> list[str]:
