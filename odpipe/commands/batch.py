@@ -5,15 +5,9 @@ overlap sequence to those arcs (e.g. leaving out a start-up arc that spans the s
 
 from pathlib import Path
 
-import pandas as pd
-
-from odpipe.analysis.overlap import consecutive_overlaps, oem_trajectory
 from odpipe.errors import Exit, describe
 from odpipe.pipeline.config import RunSection, load_config
-from odpipe.pipeline.setup import tdb
-from odpipe.pipeline.run import run_config
 from odpipe.runs.batch import load_batch, night_summary, run_batch
-from odpipe.runs.report import Section, write_report
 from odpipe.runs.schema import load, read_toml
 
 NAME = "batch"
@@ -67,6 +61,12 @@ def starts_from(arcs: list[Path], cfgs: dict | None = None, broken=()) -> dict:
 def night_report(out: Path, arcs: list[Path], outcomes, overlap_arcs: list[Path] | None = None) -> Path:
     """The night's report in ``out``: residual statistics per arc and station, overlaps of consecutive
     arcs among ``overlap_arcs`` (default all)."""
+    import pandas as pd
+
+    from odpipe.analysis.overlap import consecutive_overlaps, oem_trajectory
+    from odpipe.pipeline.setup import tdb
+    from odpipe.runs.report import Section, write_report
+
     out.mkdir(parents=True, exist_ok=True)
     status = {Path(o.config).resolve(): o for o in outcomes}
     done = []
@@ -106,10 +106,12 @@ def night_report(out: Path, arcs: list[Path], outcomes, overlap_arcs: list[Path]
 
 
 def _arc(path: Path) -> dict:
+    from odpipe.pipeline.run import run_config
     return run_config(path, progress=None)
 
 
 def _arc_forced(path: Path) -> dict:
+    from odpipe.pipeline.run import run_config
     return run_config(path, force=True, progress=None)
 
 

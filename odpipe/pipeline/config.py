@@ -22,8 +22,6 @@ import numpy as np
 
 from odpipe.runs.schema import (at_least, between, checked, file_name, internal, load, positive, read_toml,
                                 readable, readable_files)
-from parsers import formats
-
 TRACKING_READERS = ("parsers.odf", "parsers.utdf", "parsers.trk234", "parsers.tdm")  # formats.READERS of tracking
 
 
@@ -47,6 +45,8 @@ def _utc(value: str) -> np.datetime64:
 def _recognised(path: Path, readers: tuple[str, ...], what: str) -> str | None:
     """Why ``path`` is not a readable file that one of ``readers`` recognises (modules without a
     ``sniff`` are taken on trust), or None."""
+    from parsers import formats  # pandas, only when a configuration is checked (not for `odpipe --help`)
+
     why = readable(path)
     if why:
         return why
