@@ -37,10 +37,11 @@ def test_detect_formats_of_real_files(shared_data, tmp_path):
 def test_inspect_unknown_and_unreadable_inputs(tmp_path, capsys):
     (tmp_path / "notes.txt").write_text("nothing to see here\n")
     assert formats.detect(tmp_path / "notes.txt") is None
-    assert main(["inspect", str(tmp_path / "notes.txt")]) == 0
-    assert "format: not recognised" in capsys.readouterr().out
-    assert main(["inspect", str(tmp_path), str(tmp_path / "absent.odf")]) == 1  # a folder, a missing file
-    assert capsys.readouterr().out.count("error:") == 2
+    assert main(["inspect", str(tmp_path / "notes.txt")]) == 2  # bad input: an error, not a summary
+    assert "notes.txt: format not recognised" in capsys.readouterr().err
+    assert main(["inspect", str(tmp_path), str(tmp_path / "absent.odf")]) == 2  # a folder, a missing file
+    err = capsys.readouterr().err.splitlines()
+    assert err == [f"error: {tmp_path}: Is a directory", f"error: {tmp_path / 'absent.odf'}: No such file or directory"]
 
 
 @pytest.mark.realdata

@@ -24,6 +24,7 @@ correction is below ``tol_dx`` of its sigma and the post-fit RMS is stable.
 
 from __future__ import annotations
 
+import logging
 from dataclasses import dataclass
 from typing import Protocol
 
@@ -34,6 +35,8 @@ from .registry import ParameterRegistry
 from .smoother import smooth_arrays
 from .solution import Solution, checksum
 from .srif import SRIF, information_estimate, solve_information
+
+_log = logging.getLogger(__name__)
 
 EDIT_INNOVATION = 1  # row rejected by the innovation (pre-fit) k-sigma test
 OUTSIDE_ARC = 2      # row time outside [t_start, t_end]
@@ -242,6 +245,8 @@ def fit(problem: Problem, obs: Observations, t_start: float, t_end: float,
                         "sigma_scale": float(options.sigma_scale[stage]),
                         "halvings": halvings,
                         "scales": {str(g): float(v) for g, v in scale.items()}})
+        _log.info("fit iteration %d: post-fit RMS %.4g sigma (pre-fit %.4g), %d rows edited, largest epoch "
+                  "correction %.3g sigma", it + 1, rms, history[-1]["prefit_rms"], history[-1]["edited"], corr)
         # relinearize about the smoothed solution
         step_x = np.zeros_like(x_ref0)
         step_x[:n_est] = dx[0][:n_est]

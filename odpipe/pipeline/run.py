@@ -50,10 +50,10 @@ class RunLog:
     def __init__(self, progress):
         self.progress, self.lines, self.t0 = progress, [], time.perf_counter()
 
-    def __call__(self, line: str) -> None:
+    def __call__(self, line: str, terminal: bool = True) -> None:
         stamped = f"[{time.perf_counter() - self.t0:7.1f} s] {line}"
         self.lines.append(stamped)
-        if self.progress:
+        if self.progress and terminal:
             self.progress(stamped)
 
 
@@ -163,7 +163,7 @@ def _fit(table, setup, log):
     t0 = time.perf_counter()
     arc = fit_arc(table, setup)
     for h in arc.history:
-        log(f"fit iteration: {json.dumps(h, default=float)}")
+        log(f"fit iteration: {json.dumps(h, default=float)}", terminal=False)  # the fit logged it live
     log(f"fit: {'converged' if arc.converged else 'NOT converged'} in {len(arc.history)} iterations, "
         f"{time.perf_counter() - t0:.1f} s")
     return arc
