@@ -1,10 +1,13 @@
 """Station–spacecraft geometry of every row from a reference trajectory.
 
 Adds ``elevation_rx`` and ``azimuth_rx`` (rad, at the receiving station, of the
-light-time-corrected spacecraft direction) and ``rtlt_s`` (round-trip light
-time, s), which the media and editing stages use. Accuracy needed there is
-modest (mdeg, ms), so the light time is iterated twice in the geocentric frame
-and aberration is left out. Rows outside the trajectory's span, or with a
+spacecraft's apparent direction) and ``rtlt_s`` (round-trip light time, s),
+which the media and editing stages use. Accuracy needed there is modest (mdeg,
+ms): the light time is iterated twice in the geocentric frame, and the
+direction is the spacecraft's geocentric position at emission (the Earth's
+too), which for an Earth moving uniformly over the light time is the apparent
+direction (light time and annual aberration; diurnal aberration, 1.5 µrad, is
+left out). Rows outside the trajectory's span, or with a
 receiver the catalog does not know, get NaN. :func:`apparent_itrs` gives the
 same direction at any ground time (the media legs' own instants), and
 :func:`load_trajectory` the reference trajectory in a file a user names.
