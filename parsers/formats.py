@@ -12,7 +12,7 @@ from pathlib import Path
 from parsers.errors import ParseError
 
 READERS = ("parsers.odf", "parsers.utdf", "parsers.trk234", "parsers.tdm", "parsers.trk223", "parsers.ionex",
-           "parsers.maneuvers")
+           "parsers.maneuvers", "parsers.crd", "parsers.cpf", "parsers.sinex", "parsers.aer")
 HEAD_BYTES = 65536
 
 

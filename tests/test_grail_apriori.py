@@ -9,43 +9,35 @@ JGR Planets 118:1676). Our field stops at degree 12, so the fit is ~10^3 times l
 
 from __future__ import annotations
 
+from pathlib import Path
+
 import numpy as np
-import pandas as pd
 import pytest
 
-from odpipe.od.apriori import determine_orbit, doppler_rows
-
+ROOT = Path(__file__).resolve().parents[1]
 
 MOON_ROTATION_DEG_PER_DAY = 360.0 / 27.321661  # sidereal month (IAU WGCCRE: W-dot = 13.17635815 deg/day)
 
 
-def _orbit(shared_data, odf_name: str, station: str, hours: float):
-    from odpipe.dynamics import forces as F
-    from odpipe.environment.ephemeris import Ephemeris
-    from odpipe.environment.gravity import read_gravity
-    from odpipe.environment.stations import StationCatalog
-    from odpipe.frames.earth import gcrs_to_itrs
-    from odpipe.frames.moon import moon_pa_to_icrf
-    from odpipe.measurements import MeasurementSetup
-    from parsers import odf
-    from parsers.ramps import RampStore
+def _orbit(shared_data, odf_name: str, day: str, station: str, hours: float):
+    """The a priori orbit as ``odpipe apriori`` finds it (:func:`odpipe.pipeline.apriori.doppler_apriori`):
+    the GRAIL start arc's configuration (DE421, lpe200 to degree 12, Earth and Sun) on one ODF and day."""
+    from dataclasses import replace
 
-    data = odf.read(shared_data / "grail" / odf_name)
-    rows = doppler_rows(data.table, data.ramps, "181")
-    rows = rows[(rows["station_rx"] == station)]
-    rows = rows[rows["epoch"] < rows["epoch"].min() + pd.Timedelta(hours=hours)].reset_index(drop=True)
-    eph = Ephemeris.open("de421")
-    setup = MeasurementSetup(eph, StationCatalog.default(), ramps=RampStore(data.ramps), gcrs_to_itrs=gcrs_to_itrs)
-    field = read_gravity(shared_data / "gravity" / "orekit" / "GrazLGM300c.truncated")
-    model = F.ForceModel("moon", [F.PointMasses(["earth", "sun"]), F.SphericalHarmonics("moon", field, 12)],
-                         ephemeris=eph, central_gm=field.gm)
-    return rows, determine_orbit(rows, setup, model, "181", moon_pa_to_icrf, 1737.4e3)
+    from odpipe.pipeline.apriori import DopplerApriori, doppler_apriori
+    from odpipe.pipeline.config import load_config
+
+    cfg = load_config(ROOT / "runs" / "grail_b_2012_04_09_start.toml")
+    cfg = replace(cfg, data=replace(cfg.data, files=[shared_data / "grail" / odf_name]),
+                  arc=replace(cfg.arc, start=f"2012-04-{day}T00:00:00", end=f"2012-04-{day}T23:59:59"))
+    result, rows = doppler_apriori(cfg, DopplerApriori(station, hours, 12))
+    return rows, result
 
 
 @pytest.fixture(scope="module")
 def april_9(shared_data):
     """Three DSS-24 passes (2012-04-09 06:38-11:29 UTC), about 2.5 orbits."""
-    return _orbit(shared_data, "grblugf2012_100_0434smmmv1.odf", "DSS-24", 5.5)
+    return _orbit(shared_data, "grblugf2012_100_0434smmmv1.odf", "09", "DSS-24", 5.5)
 
 
 @pytest.mark.realdata
@@ -78,7 +70,7 @@ def test_grail_b_node_two_days_later_has_turned_with_the_moon(shared_data, april
     longitude in the Moon's body frame falls by the Moon's rotation: the orbits found
     independently on 04-09 (DSS-24) and 04-11 (DSS-24, file 102) must differ by that much."""
     day1 = april_9[1]
-    _, day3 = _orbit(shared_data, "grblugf2012_102_0055smmmv1.odf", "DSS-24", 4.5)
+    _, day3 = _orbit(shared_data, "grblugf2012_102_0055smmmv1.odf", "11", "DSS-24", 4.5)
     days = (day3.epoch - day1.epoch) / 86400.0  # 2.07
     turned = np.degrees(day3.elements["raan"] - day1.elements["raan"])
     assert turned == pytest.approx(-MOON_ROTATION_DEG_PER_DAY * days, abs=1.5)  # -27.8 vs -27.3 deg

@@ -95,3 +95,17 @@ def test_next_arc_starts_from_this_arcs_oem(case):
     assert overlaps["pos_3d_rms"].iloc[0] < 100.0  # m: two fits of one truth, each within tens of metres
     stats = pd.read_csv(tmp / "night" / "residual_statistics.csv")
     assert set(stats["arc"]) == {"sim_arc", "sim_arc_next"} and (tmp / "night" / "report.html").is_file()
+
+
+def test_python_api_reopens_the_run_as_odpipe_run_wrote_it(case):
+    from odpipe.api import fit_arc
+
+    tmp, out, truth = case
+    arc = fit_arc(tmp / "arc.toml")  # unchanged: skipped, the products of the run above
+    assert arc.folder == Path(out["run"]) and arc.report.is_file()
+    seg = oem.read(arc.folder / "trajectory.oem")[0]
+    t = (seg.epochs - np.datetime64("2000-01-01T12:00:00", "ns")) / np.timedelta64(1, "s")
+    assert np.abs(arc.trajectory.state(t[5:6])[0] - seg.states[5]).max() < 1e-6
+    assert np.abs(arc.trajectory.state(t[5:6])[0][:3] - truth.state(t[5:6])[0][:3]).max() < 50.0  # m
+    assert set(arc.statistics["station_rx"]) == set(arc.residuals["station_rx"].astype(str))
+    assert arc.summary["converged"] == out["converged"] and len(arc.parameters) >= 7  # state + SRP at least

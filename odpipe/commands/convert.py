@@ -28,7 +28,7 @@ def load(path, errors: str = "raise") -> TrackingData:
         return TrackingData(*read_table(path))
     data = formats.read_any(path, errors=errors)
     if not isinstance(data, TrackingData):
-        raise ValueError(f"{path}: not tracking data (a {type(data).__name__}); convert reads tracking files")
+        raise ValueError(f"{path} is not tracking data")
     return data
 
 
@@ -36,7 +36,11 @@ def run(args) -> int:
     suffix = Path(args.output).suffix.lower()
     if suffix != ".parquet" and suffix not in TDM_SYNTAX:
         raise ValueError(f"{args.output}: cannot write {suffix!r} files: name OUT.parquet, OUT.tdm, OUT.kvn or OUT.xml")
-    data = load(args.input, args.errors)
+    try:
+        data = load(args.input, args.errors)
+    except (OSError, ValueError) as exc:  # ParseError is a ValueError; so is a file that holds no tracking data
+        print(f"error: {exc}")
+        return 1
     if suffix == ".parquet":
         written = store.write(args.output, data.table, data.ramps)
     else:

@@ -69,6 +69,8 @@ def summarize(path) -> list[str]:
         return [f"format: not recognised (readers available: {', '.join(formats.available())})"]
     report = ParseReport()
     mod = importlib.import_module(name)
+    if hasattr(mod, "describe"):  # a reader of something other than tracking data (CPF, SINEX)
+        return [f"format: {name}"] + mod.describe(path)
     if name == "parsers.maneuvers":
         df = mod.read(path, errors="report", report=report)
         lines = [f"format: {name}", f"rows: {len(df)}"]

@@ -8,6 +8,9 @@ columns ``name`` (or ``station``) and either ``x_m, y_m, z_m`` (ITRS, m) or
 ``lat_deg, lon_deg, h_m`` (WGS84 geodetic); optional ``vx_m_per_yr`` (or
 ``vx``), ``vy…``, ``vz…`` and ``epoch_year`` (decimal year, default 2003.0).
 
+``catalog.with_sinex(path, at, eccentricities)`` adds the sites of a SINEX
+solution (e.g. ILRS SLRF2014) by their 4-digit code, e.g. '7090'.
+
 Station ids: 'DSS-14', 'DSS14', 'DSS 14', the ODF/TRK-2-34 integer 14, or an
 alias listed in the catalog (e.g. ESTRACK 'NNO').
 """
@@ -135,6 +138,32 @@ class StationCatalog:
         """This catalog plus (overridden by) the stations of a CSV file."""
         merged = dict(self.stations)
         merged.update({s.name: s for s in _read_stations(Path(path))})
+        return StationCatalog(list(merged.values()), f"{self.source} + {path}")
+
+    def with_sinex(self, path, at, eccentricities=None) -> "StationCatalog":
+        """This catalog plus the sites of a SINEX file whose solution span holds UTC ``at``, named by site code.
+
+        Positions (ITRS of the file's frame, m) at each solution's reference epoch
+        with its velocities; ``eccentricities`` (a SINEX SITE/ECCENTRICITY file)
+        moves each marker to its instrument reference point (UNE turned to ITRS
+        at the marker's WGS84 latitude and longitude).
+        """
+        from parsers import sinex
+
+        ecc = sinex.read(eccentricities) if eccentricities is not None else None
+        merged = dict(self.stations)
+        for r in sinex.read(path).stations(at).itertuples():
+            pos = np.array([r.x_m, r.y_m, r.z_m])
+            e = ecc.eccentricity(r.code, at) if ecc is not None else None
+            if e is not None:
+                lat, lon, _ = itrs_to_geodetic(pos)
+                une = e[["east_m", "north_m", "up_m"]].to_numpy(float)
+                pos = pos + (une @ enu_matrix(lat, lon) if e["system"] == "UNE" else e[["x_m", "y_m", "z_m"]]
+                             .to_numpy(float))
+            ref = pd.Timestamp(r.ref_epoch)
+            year_s = (pd.Timestamp(ref.year + 1, 1, 1) - pd.Timestamp(ref.year, 1, 1)).total_seconds()
+            merged[r.code] = Station(r.code, pos, np.array([r.vx_m_per_yr, r.vy_m_per_yr, r.vz_m_per_yr]),
+                                     ref.year + (ref - pd.Timestamp(ref.year, 1, 1)).total_seconds() / year_s)
         return StationCatalog(list(merged.values()), f"{self.source} + {path}")
 
     def __getitem__(self, name) -> Station:

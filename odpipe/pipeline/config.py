@@ -179,3 +179,10 @@ def load_config(path) -> RunConfig:
         raise ConfigError(path, "initial_state.state", "needs 6 numbers (m, m/s)")
     cfg.path, cfg.text = path, text
     return cfg
+
+
+def reference() -> str:
+    """The run configuration reference (Markdown), generated from the classes above."""
+    from odpipe.runs.reference import markdown
+
+    return markdown(RunConfig, "Run configuration reference", skip=("path", "text"))

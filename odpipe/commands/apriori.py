@@ -1,0 +1,34 @@
+"""``odpipe apriori``: a run's a priori orbit from its own two-way Doppler, printed as ``[initial_state]``."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+
+NAME = "apriori"
+HELP = "find a lunar orbiter's a priori orbit from the run's two-way Doppler; prints the [initial_state] entries"
+
+
+def add_arguments(parser) -> None:
+    parser.add_argument("config", type=Path, help="run configuration (TOML): its data, arc, centre and field are used")
+    parser.add_argument("--station", help="receiving station of the Doppler used, e.g. DSS-24 (default: the one "
+                                          "with the most 60-s points in the arc's first 8 h)")
+    parser.add_argument("--span", type=float, default=5.5, help="hours of that station's Doppler used (default 5.5)")
+    parser.add_argument("--degree", type=int, default=12, help="degree of the central body's field (default 12)")
+
+
+def run(args) -> int:
+    from odpipe.pipeline.apriori import DopplerApriori, doppler_apriori, initial_state_toml
+    from odpipe.pipeline.config import load_config
+
+    cfg = load_config(args.config)
+    res, rows = doppler_apriori(cfg, DopplerApriori(args.station, args.span, args.degree))
+    el = res.elements
+    print(f"# {len(rows)} 60-s two-way Doppler points of {rows['station_rx'].iloc[0]}, "
+          f"{rows['epoch'].min():%Y-%m-%dT%H:%M:%S} .. {rows['epoch'].max():%Y-%m-%dT%H:%M:%S} UTC; "
+          f"post-fit {res.rms_los * 1e3:.0f} mm/s ({res.rms_hz * 1e3:.0f} mHz)")
+    print(f"# altitude {el['altitude'] / 1e3:.1f} km, period {el['period'] / 60:.2f} min, e {el['e']:.4f}, "
+          f"inclination {np.degrees(el['inc']):.2f} deg, node {np.degrees(el['raan']):.2f} deg (body frame)")
+    print(initial_state_toml(res), end="")
+    return 0

@@ -1,0 +1,81 @@
+"""The a priori orbit of a run from its own two-way Doppler (:func:`odpipe.od.apriori.determine_orbit`).
+
+For a spacecraft with no ephemeris: the arc's data are read, the two-way Doppler of one station (by
+default the one with the most 60-s points in the arc's first 8 h) over its first ``span_hours`` is
+taken, and a circular-orbit grid search refined through a low-degree field of the run's central body
+gives the epoch state (ICRF about the centre, m, m/s). Lunar orbiters only: the grid search needs the
+body's principal-axis frame.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+import pandas as pd
+
+from odpipe.dynamics import forces as F
+from odpipe.environment.ephemeris import Ephemeris
+from odpipe.environment.gravity import read_gravity
+from odpipe.frames.earth import gcrs_to_itrs
+from odpipe.frames.moon import moon_pa_to_icrf
+from odpipe.measurements import MeasurementSetup
+from odpipe.od.apriori import AprioriResult, determine_orbit, doppler_rows
+from odpipe.pipeline.config import RunConfig
+from odpipe.pipeline.ingest import ingest
+from odpipe.pipeline.setup import station_catalog
+from odpipe.runs.schema import ConfigError
+from odpipe.time import tdb_to_utc
+
+FRAMES = {"moon": moon_pa_to_icrf}  # central body -> its body-fixed (PA) frame to ICRF, for the grid search
+
+
+@dataclass(frozen=True)
+class DopplerApriori:
+    """How the a priori orbit is found: station (None: the busiest in the first 8 h), the span of its
+    Doppler used (h), and the degree of the central body's field in the refinement."""
+
+    station: str | None = None
+    span_hours: float = 5.5
+    degree: int = 12
+
+
+def doppler_apriori(cfg: RunConfig, how: DopplerApriori = DopplerApriori()) -> tuple[AprioriResult, pd.DataFrame]:
+    """The a priori epoch state of ``cfg``'s arc from its Doppler, and the rows it used."""
+    center = cfg.dynamics.center.lower()
+    if center not in FRAMES:
+        raise ConfigError(cfg.path, "dynamics.center", f"an a priori orbit from Doppler needs a lunar orbiter, "
+                                                       f"not one about {cfg.dynamics.center}")
+    fields = [g for g in cfg.dynamics.gravity if g.body.lower() == center]
+    if not fields:
+        raise ConfigError(cfg.path, "dynamics.gravity", f"an a priori orbit from Doppler needs a field of {center}")
+    data = ingest(list(cfg.data.files))
+    catalog = station_catalog(cfg)
+    rows = doppler_rows(data.table, data.ramps, cfg.arc.spacecraft)
+    t0, t1 = pd.Timestamp(cfg.arc.start), pd.Timestamp(cfg.arc.end)
+    rows = rows[(rows["epoch"] >= t0) & (rows["epoch"] <= t1) & rows["station_rx"].isin(catalog.stations)]
+    if rows.empty:
+        raise ConfigError(cfg.path, "data.files", f"no two-way Doppler of spacecraft {cfg.arc.spacecraft} from a "
+                                                  f"catalogued station between {cfg.arc.start} and {cfg.arc.end}")
+    station = how.station
+    if station is None:
+        first = rows[rows["epoch"] < rows["epoch"].min() + pd.Timedelta(hours=8)]
+        station = first["station_rx"].value_counts().idxmax()
+    rows = rows[rows["station_rx"] == station]
+    if rows.empty:
+        raise ConfigError(cfg.path, "initial_state.from_doppler.station", f"no two-way Doppler from {station}")
+    rows = rows[rows["epoch"] < rows["epoch"].min() + pd.Timedelta(hours=how.span_hours)].reset_index(drop=True)
+    field = read_gravity(fields[0].file)
+    model = F.ForceModel(center, [F.PointMasses(list(cfg.dynamics.third_bodies)),
+                                  F.SphericalHarmonics(center, field, min(how.degree, fields[0].degree))],
+                         ephemeris=Ephemeris.open(str(cfg.dynamics.ephemeris)), central_gm=field.gm)
+    setup = MeasurementSetup(model.ephemeris, catalog, ramps=data.store, gcrs_to_itrs=gcrs_to_itrs)
+    return determine_orbit(rows, setup, model, cfg.arc.spacecraft, FRAMES[center], F.BODY_RADIUS[center]), rows
+
+
+def initial_state_toml(result: AprioriResult) -> str:
+    """The ``[initial_state]`` entries of a run configuration for ``result`` (UTC epoch to the ms)."""
+    utc = str(np.datetime64(tdb_to_utc(np.array([result.epoch]))[0], "ms"))
+    pos = ", ".join(f"{v:.3f}" for v in result.state[:3])
+    vel = ", ".join(f"{v:.6f}" for v in result.state[3:])
+    return f'[initial_state]\nepoch = "{utc}"\nstate = [{pos}, {vel}]   # m, m/s, ICRF about the centre\n'
