@@ -163,6 +163,9 @@ def test_trajectory_from_oem_spk_or_run_directory(files, tmp_path):
         load_trajectory(run)
     with pytest.raises(ValueError, match=r"in.parquet: not a trajectory: expected a CCSDS OEM"):
         load_trajectory(src)
+    (tmp_path / "bad.bsp").write_bytes(b"DAF/SPK " + bytes(100))     # an SPK cut short
+    with pytest.raises(ValueError, match=r"bad.bsp: not a readable SPK: SPICE\(FILEREADFAILED\)"):
+        load_trajectory(tmp_path / "bad.bsp")
 
 
 def test_compress_and_edit_refuse_input_they_cannot_take(shared_data, files, capsys, caplog):

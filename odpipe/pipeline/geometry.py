@@ -7,9 +7,9 @@ ms): the light time is iterated twice in the geocentric frame, and the
 direction is the spacecraft's geocentric position at emission (the Earth's
 too), which for an Earth moving uniformly over the light time is the apparent
 direction (light time and annual aberration; diurnal aberration, 1.5 µrad, is
-left out). Rows outside the trajectory's span, or with a
-receiver the catalog does not know, get NaN. :func:`apparent_itrs` gives the
-same direction at any ground time (the media legs' own instants), and
+left out). Rows whose signal left the spacecraft outside the trajectory's span,
+or with a receiver the catalog does not know, get NaN. :func:`apparent_itrs`
+gives the same direction at any ground time (the media legs' own instants), and
 :func:`load_trajectory` the reference trajectory in a file a user names.
 """
 
@@ -56,9 +56,9 @@ def add_geometry(table: pd.DataFrame, trajectory, ephemeris, catalog) -> pd.Data
 
 def apparent_itrs(trajectory, ephemeris):
     """``target_itrs(t_utc) -> (N, 3)`` m: the spacecraft's ITRS position at ground times ``t_utc``,
-    light-time corrected from the geocentre (the station's own light time differs by < 22 ms, a
-    direction change of micro-radians); NaN where the signal left the spacecraft outside the
-    trajectory's span."""
+    light-time corrected from the geocentre (the station's own light time differs by < 22 ms: under
+    0.1 µrad of direction at lunar or planetary distances); NaN where the signal left the spacecraft
+    outside the trajectory's span."""
     lo, hi = _span(trajectory)
 
     def target(t_utc):
@@ -138,8 +138,12 @@ def _spk_trajectory(path: Path, naif_id: int | None):
 def _spk_segments(path: Path) -> dict[int, int]:
     """{body: centre} NAIF ids of an SPK's segments (the first segment's centre per body)."""
     import spiceypy as sp
+    from spiceypy.utils.exceptions import SpiceyError
 
-    handle = sp.dafopr(str(path))
+    try:
+        handle = sp.dafopr(str(path))
+    except SpiceyError as err:
+        raise ValueError(f"{path}: not a readable SPK: {err.short} {' '.join(err.long.split())}") from None
     try:
         sp.dafbfs(handle)
         out = {}
