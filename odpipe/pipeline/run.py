@@ -26,7 +26,7 @@ from odpipe.media.model import MediaModel
 from odpipe.od.arc import ManeuverPlan, fit_arc
 from odpipe.pipeline import setup as build
 from odpipe.pipeline.config import RunConfig, load_config
-from odpipe.pipeline.geometry import add_geometry
+from odpipe.pipeline.geometry import add_geometry, apparent_itrs, median_round_trip
 from odpipe.pipeline.ingest import ingest
 from odpipe.pipeline.products import fitted_segments
 from odpipe.preprocess.compress import compress
@@ -113,7 +113,8 @@ def _run(cfg: RunConfig, attempt, log: RunLog) -> dict:
     if cal.media:
         model = MediaModel(read_trk223(*cal.tro, *cal.ion) if (cal.tro or cal.ion) else None,
                            IonexModel(read_ionex(*cal.ionex)) if cal.ionex else None)
-        table, _ = calibrate(table, model, ramps=data.store, catalog=catalog,
+        table, _ = calibrate(table, model, target_itrs=apparent_itrs(apriori, fm.ephemeris), ramps=data.store,
+                             catalog=catalog,
                              order=None if cal.smoothing_order < 0 else cal.smoothing_order)
         log(f"calibrate: media on {int(np.isfinite(table['media_m']).sum())} rows; "
             f"sources {dict(table['media_source'].value_counts().head(4))}")
@@ -121,7 +122,7 @@ def _run(cfg: RunConfig, attempt, log: RunLog) -> dict:
         log("calibrate: media corrections off (calibration.media = false)")
 
     pre = cfg.preprocess
-    rtlt = float(np.nanmedian(table["rtlt_s"])) if np.isfinite(table["rtlt_s"]).any() else 0.0
+    rtlt = median_round_trip(table)
     n_raw = len(table)
     table, creport = compress(table, pre.count_time, ramps=data.ramps, partial=pre.partial, ramp_delay=rtlt)
     log(f"compress: {n_raw} rows -> {len(table)} at {pre.count_time:g} s count time")
