@@ -30,7 +30,10 @@ of one vehicle and pad (or count / interval for destruct Doppler; NaN for the
 first of a series), angles in rad. Extra columns: ``valid`` (the row's
 validity bit), ``validity`` (the byte), ``vid``, ``tracker_type``,
 ``band_code``, ``data_interval_s``, ``doppler_count``, ``factor_m`` and
-``doppler_shift_hz`` (the format's own signed shift, positive approaching). ``meta["records"]`` holds every field of every
+``doppler_shift_hz`` (the format's own signed shift, positive approaching). A row that
+repeats an earlier one's sample (a duplicated record) is kept with the DUPLICATE flag,
+a row without a finite value with the INVALID flag (:mod:`parsers.table`); an empty
+file is a ParseError in both modes. ``meta["records"]`` holds every field of every
 record (AGC, mode, antenna types, router, TDRSS-only bytes, ...; join on
 ``record``) and :func:`write` turns such a frame back into bytes, bit for bit.
 """
@@ -89,13 +92,15 @@ def read(path, errors: str = "raise") -> TrackingData:
     buf = path.read_bytes()
     report = ParseReport()
     n = len(buf) // RECORD
+    if n == 0:
+        raise ParseError(path, f"no UTDF record: {len(buf)} bytes, a record is {RECORD}", offset=0)
     if len(buf) % RECORD:
         handle(ParseError(path, f"trailing partial record of {len(buf) % RECORD} bytes",
                           offset=n * RECORD, record=n), errors, report)
     raw = np.frombuffer(buf, DTYPE, count=n)
     ok = _check(path, raw, errors, report)
     rec = records_frame(raw[ok], np.flatnonzero(ok))
-    table = _table(rec, str(path))  # already in time order
+    table = tt.flag_duplicates(_table(rec, str(path)))  # already in time order
     meta = {"records": rec, "sic": sorted(set(rec["sic"].tolist())),
             "vid": sorted(set(rec["vid"].tolist()))}
     return TrackingData(table=table, ramps=tt.empty_ramps(), report=report, meta=meta)

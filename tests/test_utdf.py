@@ -16,10 +16,7 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 import pytest
-from hypothesis import HealthCheck, given, settings
-from hypothesis import strategies as st
 
-from tests.fuzzing import mutated
 from parsers import ParseError, utdf
 
 C_KM_S = 299792.458
@@ -174,28 +171,6 @@ def test_truncated_and_corrupt_records(shared_data, tmp_path):
 def test_sniff(shared_data):
     assert utdf.sniff((shared_data / LSUTDF).read_bytes()[:80])
     assert not utdf.sniff((shared_data / "messenger/odf07155.odf").read_bytes()[:80])
-
-
-@pytest.fixture(scope="module")
-def utdf_head(shared_data):
-    return (shared_data / LSUTDF).read_bytes()[: 75 * 40]
-
-
-@pytest.mark.realdata
-@settings(max_examples=150, deadline=None, suppress_health_check=[HealthCheck.function_scoped_fixture])
-@given(data=st.data())
-def test_fuzz_only_parse_errors(utdf_head, tmp_path_factory, data):
-    buf = mutated(data, utdf_head)
-    p = tmp_path_factory.mktemp("fuzz") / "f.utdf"
-    p.write_bytes(bytes(buf))
-    for mode in ("raise", "report"):
-        try:
-            d = utdf.read(p, errors=mode)
-        except ParseError:
-            continue
-        assert len(d.meta["records"]) <= len(buf) // 75
-        assert utdf.encode(d.meta["records"]) == b"".join(
-            bytes(buf[i * 75:(i + 1) * 75]) for i in d.meta["records"].index)
 
 
 def test_running_count_is_not_differenced_across_a_pass_gap(tmp_path):
