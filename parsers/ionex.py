@@ -155,7 +155,7 @@ def _read_one(path: Path, errors: str, report: ParseReport | None) -> IonexMaps:
                 kind, epoch, grid, i = _map(lines, i, label, grids, exponent, path)
             except ParseError as err:
                 handle(err, errors, report)
-                i = _skip_map(lines, max(i, (err.line or i)), label)
+                i = _skip_map(lines, max(i, (err.line or 1) - 1), label)
                 continue
             if epoch in maps[kind]:
                 handle(ParseError(path, f"a second {kind} map at {epoch}", line=i, record=label), errors, report)

@@ -111,7 +111,7 @@ def _plan_epoch(value, path, loc) -> np.datetime64:
         ts = pd.Timestamp(value)
         if ts.tzinfo is not None:
             ts = ts.tz_convert("UTC").tz_localize(None)
-        return ts.to_datetime64().astype("datetime64[ns]")
+        return ts.as_unit("ns").to_datetime64()  # raises beyond 1677-2262 (e.g. year 0)
     except (ValueError, OverflowError) as exc:  # pandas' OutOfBoundsDatetime is a ValueError
         raise ParseError(path, f"epoch {str(value)[:40]!r}: {exc}", **loc) from None
 

@@ -123,6 +123,8 @@ _EPOCH = re.compile(r"\d{4}-(\d{2}-\d{2}|\d{3})T\d{2}:\d{2}:\d{2}(\.\d{1,9})?Z?"
 def _epoch(path, lineno, text):
     if not _EPOCH.fullmatch(text):
         raise ParseError(path, f"bad epoch {text[:40]!r} (want YYYY-MM-DDThh:mm:ss[.f])", line=lineno)
+    if not 1678 <= int(text[:4]) <= 2261:  # datetime64[ns] would wrap round silently
+        raise ParseError(path, f"epoch {text[:40]!r} is outside 1678-2261", line=lineno)
     try:
         return np.datetime64(text.rstrip("Z"), "ns")
     except ValueError:
