@@ -192,3 +192,29 @@ def test_layout_lengths_match_the_sis_table():
         assert layout.dtype(fc).itemsize - 20 == n
     assert layout.dtype(16, 5).itemsize - 20 == 182 + 18 * 5
     assert layout.dtype(17, 5).itemsize - 20 == 194 + 22 * 5
+
+
+def test_duplicated_sfdu_is_flagged_not_dropped(tmp_path):
+    from parsers import table as tt
+    good = trk234.read(SAMPLE)
+    first = good.meta["blocks"][0]
+    size = first.records.dtype.itemsize
+    buf = SAMPLE.read_bytes()
+    k = int(np.flatnonzero(first.index == first.index.min())[0])
+    start = sum(b.records.dtype.itemsize for b in good.meta["blocks"] for i in b.index if i < first.index[k])
+    p = tmp_path / "dup.tnf"
+    p.write_bytes(buf + buf[start:start + size])  # the first SFDU again at the end
+    d = trk234.read(p)
+    dup = (d.table["flags"] & tt.DUPLICATE) != 0
+    n_records = sum(d.meta["sfdu_counts"].values())
+    assert dup.sum() == (good.table["record"] == first.index[k]).sum() > 0
+    assert set(d.table.loc[dup, "record"]) == {n_records - 1}
+    assert not ((good.table["flags"] & tt.DUPLICATE) != 0).any()
+
+
+def test_empty_file_is_a_parse_error_in_both_modes(tmp_path):
+    p = tmp_path / "empty.tnf"
+    p.write_bytes(b"")
+    for mode in ("raise", "report"):
+        with pytest.raises(ParseError, match="empty"):
+            trk234.read(p, errors=mode)
