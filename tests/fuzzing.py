@@ -262,12 +262,13 @@ def _alarm(signum, frame):
 
 @dataclass
 class Tally:
-    """Inputs fed to one reader and what came out (each input read in both modes)."""
+    """Inputs fed to one reader and what came out."""
 
     inputs: int = 0
-    parse_errors: int = 0   # inputs refused in errors="raise" mode
-    reported: int = 0       # inputs read in errors="report" mode with at least one record reported
-    seconds: float = 0.0     # CPU time of this process
+    parse_errors: int = 0   # inputs refused with ParseError in errors="raise" mode
+    refused: int = 0        # of those, refused whole in errors="report" mode too (file-level faults)
+    reported: int = 0       # of those, read in errors="report" mode with the bad records reported
+    seconds: float = 0.0    # CPU time of this process
 
 
 def run(name: str, data: Path, n: int, seed: int = 0, limit_s: float = 5.0, folder: Path | None = None) -> Tally:
@@ -286,10 +287,12 @@ def run(name: str, data: Path, n: int, seed: int = 0, limit_s: float = 5.0, fold
                 blob = mutate(seeds[i % len(seeds)], rng)
                 path.write_bytes(blob)
                 tally.inputs += 1
-                refused = _one(reader, path, "raise", name, i, blob, limit_s)
-                tally.parse_errors += refused
-                if refused:  # a file read whole in "raise" mode reads the same in "report" mode
-                    tally.reported += _one(reader, path, "report", name, i, blob, limit_s)
+                if _one(reader, path, "raise", name, i, blob, limit_s) is None:
+                    tally.parse_errors += 1
+                    # (a file read whole in "raise" mode reads the same in "report" mode)
+                    report = _one(reader, path, "report", name, i, blob, limit_s)
+                    tally.refused += report is None
+                    tally.reported += report is not None and len(report) > 0
         finally:
             signal.setitimer(signal.ITIMER_REAL, 0)
             signal.signal(signal.SIGALRM, old)
@@ -297,13 +300,13 @@ def run(name: str, data: Path, n: int, seed: int = 0, limit_s: float = 5.0, fold
     return tally
 
 
-def _one(reader: Reader, path: Path, errors: str, name: str, i: int, blob: bytes, limit_s: float) -> int:
-    """1 when the input was refused (raise) or had records reported (report), else 0."""
+def _one(reader: Reader, path: Path, errors: str, name: str, i: int, blob: bytes, limit_s: float):
+    """The reader's ParseReport, or None when it raised ParseError; :class:`Crash` otherwise."""
     signal.setitimer(signal.ITIMER_REAL, limit_s)
     try:
-        report = reader.read(path, errors)
+        return reader.read(path, errors)
     except ParseError:
-        return 1
+        return None
     except _Hang:
         raise Crash(f"{name} input {i} ({errors}): no answer within {limit_s} s; input {blob[:120]!r}...") from None
     except Exception as exc:
@@ -311,4 +314,3 @@ def _one(reader: Reader, path: Path, errors: str, name: str, i: int, blob: bytes
                     f"input {blob[:120]!r}...") from exc
     finally:
         signal.setitimer(signal.ITIMER_REAL, 0)
-    return int(len(report) > 0)

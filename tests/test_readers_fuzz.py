@@ -18,5 +18,5 @@ INPUTS = {"odf": 250, "utdf": 150, "trk234": 150, "tdm_kvn": 200, "tdm_xml": 250
 def test_only_parse_errors_and_no_hang(name, shared_data, tmp_path):
     tally = run(name, shared_data, INPUTS[name], seed=1, limit_s=5.0, folder=tmp_path)
     assert tally.inputs == INPUTS[name]
-    # the mutations must reach past the first check: some inputs are refused, some are read
+    # the mutations reach past the first check: some inputs are read whole, some refused
     assert 0 < tally.parse_errors < tally.inputs
