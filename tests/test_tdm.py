@@ -251,3 +251,11 @@ def test_non_finite_metadata_number_is_a_parse_error(kvn, tmp_path):
     p.write_text(text.replace("TRANSMIT_DELAY_1 = 0.000077", "TRANSMIT_DELAY_1 = 1e400"))
     with pytest.raises(ParseError, match="TRANSMIT_DELAY_1"):
         tdm.read(p, errors="report")
+
+
+@pytest.mark.parametrize("name, line, rows", [("kvn/TDM-data-wrong-keyword.txt", 26, 6),
+                                              ("xml/TDM-data-wrong-keyword.xml", 47, 6)])
+def test_wrong_data_keyword_is_reported_in_both_syntaxes(shared_data, name, line, rows):
+    d = tdm.read(shared_data / "tdm" / name, errors="report")
+    assert [(e.line, e.record) for e in d.report] == [(line, "WRONG_KEYWORD")]
+    assert len(d.table) == rows

@@ -41,7 +41,7 @@ def read(path, errors: str = "raise") -> TrackingData:
     collecting = gc.isenabled()
     gc.disable()  # millions of small objects, no cycles: the cyclic collector only costs time here
     try:
-        msg = xml.parse(raw, path) if is_xml else kvn.parse(decode(raw, path), path, errors, report)
+        msg = xml.parse(raw, path, errors, report) if is_xml else kvn.parse(decode(raw, path), path, errors, report)
     finally:
         if collecting:
             gc.enable()
