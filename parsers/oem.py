@@ -4,18 +4,17 @@ Returns one :class:`OemSegment` per META block: its metadata, epochs as
 datetime64[ns] in the file's own TIME_SYSTEM (named in ``meta``), states in
 m and m/s (the file's km, km/s converted), and covariances in m², m²/s,
 m²/s² when the segment has a covariance block. With ``errors="report"`` an
-unreadable ephemeris line or covariance matrix is left out and added to the
-report; faults of the file's structure always raise.
+unreadable ephemeris line is left out and added to the report; other faults
+(structure, covariance blocks) always raise.
 """
 
 from __future__ import annotations
 
+import re
 from dataclasses import dataclass, field
 from pathlib import Path
 
 import numpy as np
-
-import re
 
 from parsers.errors import ParseError, ParseReport, check_mode, finite, handle, read_text
 

@@ -20,3 +20,23 @@ def test_only_parse_errors_and_no_hang(name, shared_data, tmp_path):
     assert tally.inputs == INPUTS[name]
     # the mutations reach past the first check: some inputs are read whole, some refused
     assert 0 < tally.parse_errors < tally.inputs
+
+
+def test_the_harness_catches_other_exceptions_and_hangs(monkeypatch, tmp_path):
+    import time
+
+    from tests import fuzzing
+
+    def reader(fail):
+        def read(path, errors):
+            if b"\n" in path.read_bytes():
+                fail()
+            raise fuzzing.ParseError(path, "refused")
+        return fuzzing.Reader(read, lambda data: [b"a\nb" * 50], ".txt")
+
+    monkeypatch.setitem(fuzzing.READERS, "raises", reader(lambda: int("x")))
+    monkeypatch.setitem(fuzzing.READERS, "hangs", reader(lambda: time.sleep(5)))
+    with pytest.raises(fuzzing.Crash, match="ValueError"):
+        run("raises", tmp_path, 50)
+    with pytest.raises(fuzzing.Crash, match="no answer within 0.2 s"):
+        run("hangs", tmp_path, 50, limit_s=0.2)
