@@ -168,8 +168,8 @@ def _read_one(path: Path, errors: str, report: ParseReport | None) -> IonexMaps:
         raise ParseError(path, "no TEC map", line=i)
     epochs = np.array(sorted(maps["TEC"]), dtype="datetime64[ns]")
     if len(epochs) != nmaps or epochs[0] != first:
-        handle(ParseError(path, f"header says {nmaps} maps from {first}, file has {len(epochs)} from {epochs[0]}"),
-               errors, report)
+        handle(ParseError(path, f"header says {nmaps} maps from {first}, file has {len(epochs)} from {epochs[0]}",
+                          line=head["# OF MAPS IN FILE"][1], record="# OF MAPS IN FILE"), errors, report)
     tec = np.stack([maps["TEC"][e] for e in epochs])
     rms = np.stack([maps["RMS"][e] for e in epochs]) if set(maps["RMS"]) == set(maps["TEC"]) else None
     hgt = np.stack([maps["HEIGHT"][e] for e in epochs]) * 1e3 if set(maps["HEIGHT"]) == set(maps["TEC"]) else None

@@ -173,7 +173,8 @@ def _toml_rows(text: str, path) -> tuple[list, list]:
     try:
         doc = tomllib.loads(text)
     except (tomllib.TOMLDecodeError, ValueError, RecursionError) as exc:  # ValueError: e.g. a 5000-digit integer
-        raise ParseError(path, f"TOML: {str(exc)[:200]}") from None
+        at = re.search(r"at line (\d+)", str(exc))
+        raise ParseError(path, f"TOML: {str(exc)[:200]}", line=int(at[1]) if at else None) from None
     if set(doc) != {"maneuver"} or not isinstance(doc["maneuver"], list):
         raise ParseError(path, f"a plan holds only [[maneuver]] tables, not {sorted(doc)[:5]}")
     rows = []
