@@ -10,13 +10,15 @@ import enum
 import numpy as np
 import pandas as pd
 
+from parsers import table as tt
+
 
 class Flag(enum.IntFlag):
     """One bit per edit reason."""
 
     ELEVATION = 1 << 0       # below the station elevation mask
-    DUPLICATE = 1 << 1       # same sample already present (first occurrence kept)
-    INVALID = 1 << 2         # the format itself marks the record invalid
+    DUPLICATE = tt.DUPLICATE  # same sample already present (first occurrence kept); readers set it too
+    INVALID = tt.INVALID      # the format marks the record invalid, or the value is not finite (set at read)
     BLUNDER = 1 << 3         # gross outlier of the detrended signal (median/MAD)
     AMBIGUITY = 1 << 4       # range outside its modulus or ambiguous against the model
     USER = 1 << 5            # analyst's edit window

@@ -5,7 +5,8 @@
 segment's metadata, which ``write`` uses to turn a TrackingData back into a TDM in either
 syntax. Malformed files raise :class:`parsers.ParseError` naming file, line and keyword;
 with ``errors="report"`` bad data lines are reported and skipped (metadata faults always
-raise). XML DOCTYPE/ENTITY declarations are refused.
+raise). Values that are not finite (NaN, inf) are kept with the INVALID flag. XML
+DOCTYPE/ENTITY declarations are refused; KVN must be UTF-8.
 """
 
 from __future__ import annotations
@@ -15,7 +16,7 @@ import os
 import tempfile
 from pathlib import Path
 
-from parsers.errors import ParseReport
+from parsers.errors import ParseReport, check_mode, decode
 from parsers.table import TrackingData
 from parsers.tdm import keywords, kvn, times, xml
 from parsers.tdm.message import Message, Segment
@@ -32,17 +33,18 @@ def sniff(head: bytes) -> bool:
 
 def read(path, errors: str = "raise") -> TrackingData:
     """Read a KVN or XML TDM."""
+    check_mode(errors)
     path = Path(path)
     raw = path.read_bytes()
+    report = ParseReport()
     is_xml = raw.lstrip(b"\xef\xbb\xbf \t\r\n").startswith(b"<")
     collecting = gc.isenabled()
     gc.disable()  # millions of small objects, no cycles: the cyclic collector only costs time here
     try:
-        msg = xml.parse(raw, path) if is_xml else kvn.parse(raw.decode("utf-8", errors="replace"), path)
+        msg = xml.parse(raw, path, errors, report) if is_xml else kvn.parse(decode(raw, path), path, errors, report)
     finally:
         if collecting:
             gc.enable()
-    report = ParseReport()
     table, ramps = tracking(msg, path.name, path, errors, report)
     templates = [Segment(meta=s.meta, meta_comments=s.meta_comments, data_comments=s.data_comments)
                  for s in msg.segments]
