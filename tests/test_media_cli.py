@@ -28,4 +28,4 @@ def test_calibrate_command_writes_table_report_and_plots(shared_data, tmp_path, 
     assert rng["media_source"].str.contains("S18TIGE2006_032_2006_059.ION:314").all()
     assert sorted(p.name for p in (tmp_path / "png").iterdir()) == ["media_pass_0.png", "media_pass_1.png"]
     assert len(pd.read_csv(tmp_path / "passes.csv")) == 2
-    assert not (tmp_path / "out.parquet.tmp").exists()
+    assert not list(tmp_path.rglob("*.part"))  # no temporary file of the atomic writer is left

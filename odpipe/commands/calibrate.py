@@ -2,10 +2,11 @@
 
 from __future__ import annotations
 
-import os
 from pathlib import Path
 
 import pandas as pd
+
+from odpipe.products.atomic import write_csv, write_parquet
 
 NAME = "calibrate"
 HELP = "apply media calibrations (TRK-2-23 .TRO/.ION, IONEX) to a TrackingTable Parquet file"
@@ -41,9 +42,9 @@ def run(args) -> int:
         catalog = catalog.with_csv(args.stations)
     ramps = pd.read_parquet(args.ramps) if args.ramps else None
     out, report = calibrate(table, model, catalog=catalog, ramps=ramps, order=None if args.order < 0 else args.order)
-    _write_atomic(out, Path(args.output))
+    write_parquet(args.output, out)
     if args.report:
-        report.to_csv(args.report, index=False)
+        write_csv(args.report, report, index=False)
     if args.plots:
         Path(args.plots).mkdir(parents=True, exist_ok=True)
         for pid in report["pass_id"]:
@@ -51,9 +52,3 @@ def run(args) -> int:
     flagged = int((report["notes"] != "").sum())
     print(f"{len(out)} rows, {len(report)} passes calibrated; {flagged} passes with fallbacks (see notes)")
     return 0
-
-
-def _write_atomic(df: pd.DataFrame, path: Path) -> None:
-    tmp = path.with_name(path.name + ".tmp")
-    df.to_parquet(tmp)
-    os.replace(tmp, path)

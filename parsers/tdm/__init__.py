@@ -11,10 +11,9 @@ raise). XML DOCTYPE/ENTITY declarations are refused.
 from __future__ import annotations
 
 import gc
-import os
-import tempfile
 from pathlib import Path
 
+from parsers.atomic import write_text
 from parsers.errors import ParseReport
 from parsers.table import TrackingData
 from parsers.tdm import keywords, kvn, times, xml
@@ -55,13 +54,4 @@ def write(path, data: TrackingData, syntax: str = "kvn") -> None:
     """Write ``data`` (as read by :func:`read`) as a TDM in ``syntax`` "kvn" or "xml", atomically."""
     msg: Message = message(data.table, data.meta)
     text = {"kvn": kvn.render, "xml": xml.render}[syntax](msg)
-    folder = os.path.dirname(os.path.abspath(path))
-    fd, tmp = tempfile.mkstemp(dir=folder, prefix=".tdm-")
-    try:
-        with os.fdopen(fd, "w", encoding="utf-8") as f:
-            f.write(text)
-        os.chmod(tmp, 0o644)
-        os.replace(tmp, path)
-    except BaseException:
-        os.unlink(tmp)
-        raise
+    write_text(path, text)
