@@ -21,7 +21,7 @@ import numpy as np
 import pandas as pd
 
 from odpipe.dynamics.forces import ForceModel, SolarRadiationPressure
-from odpipe.estimation.fit import EDIT_INNOVATION, FitOptions, Observations, Solution, build_grid, fit
+from odpipe.estimation.fit import EDIT_INNOVATION, NONFINITE, FitOptions, Observations, Solution, build_grid, fit
 from odpipe.estimation.maneuvers import maneuver_table
 from odpipe.estimation.registry import GaussMarkov, ParameterRegistry
 from odpipe.measurements import MeasurementSetup
@@ -248,6 +248,9 @@ def _solution(setup, reg, problem, sol, rows, times, to_los, status) -> ArcSolut
     edited = np.zeros(len(res), bool)
     edited[good] = (sol.residuals["flags"].to_numpy() & EDIT_INNOVATION) != 0
     res.loc[edited, "flags"] = int(Flag.RESIDUAL)
+    nonfinite = np.zeros(len(res), bool)
+    nonfinite[good] = (sol.residuals["flags"].to_numpy() & NONFINITE) != 0
+    res.loc[nonfinite, "flags"] |= int(Flag.NONFINITE)
     est = sol.parameters()
     params = pd.DataFrame({"name": reg.names, "kind": [p.kind for p in reg.parameters], "apriori": reg.apriori,
                            "estimate": est["estimate"].to_numpy(), "sigma": est["sigma"].to_numpy()})
