@@ -3,11 +3,13 @@
 A night of ``--arcs`` simulated 6-h arcs (the cislunar HEO of ``tests/heo_case.py`` tracked by three DSN
 sites, Doppler and range; consecutive arcs overlap by 2 h) runs as ``odpipe batch`` on a local Dask
 cluster of two worker processes. Its whole process group (client, nanny and workers) is SIGKILLed after
-a random delay, ``--kills`` times, and the batch is run again each time; a last run goes to the end.
-After every kill: each arc finished before it is still current with the same manifest, and every
-``current`` verifies against its manifest's checksums. At the end: every arc and the night's report are
-complete, every product parses, each arc has exactly one complete attempt (no arc fitted twice), every
-other attempt folder is marked abandoned, and no temporary file is left.
+a random delay (uniform in ``--min-delay``..``--max-delay`` s, a full night taking about 100 s) and the
+batch is run again, until ``--kills`` kills have hit a running batch. After every kill: each arc
+finished before it is still current with the same manifest, and every ``current`` verifies against its
+manifest's checksums. When a run ends before its kill, the night is complete and checked, and a new
+night starts from the same inputs: every arc and the night's report are complete, every product parses,
+each arc has exactly one complete attempt (no arc fitted twice), every other attempt folder is marked
+abandoned, and no temporary file is left.
 
 Run: ``.venv/bin/python benchmarks/bench_faults.py [--kills 20] [--arcs 6] [--min-delay 5] [--max-delay 100] [--seed 1]``.
 """
@@ -17,6 +19,7 @@ from __future__ import annotations
 import argparse
 import json
 import os
+import shutil
 import signal
 import subprocess
 import sys
@@ -158,46 +161,60 @@ def check_night(folder: Path, arcs: int) -> dict:
     return counts
 
 
-def fault_loop(folder: Path, kills: int, arcs: int = 6, min_delay: float = 1.0, max_delay: float = 40.0,
+def fault_loop(folder: Path, kills: int, arcs: int = 6, min_delay: float = 5.0, max_delay: float = 100.0,
                seed: int = 1, say=print) -> dict:
-    """Kill the batch ``kills`` times at random moments, rerunning it; then run it to the end and check."""
+    """Run the batch and SIGKILL it after a random delay until ``kills`` kills have hit a running batch.
+
+    A run that ends before its kill is a finished night: it is checked (:func:`check_night`) and its
+    outputs removed, and the next run starts a new night from the same inputs; after the last kill the
+    batch runs to the end and that night is checked too."""
     rng = np.random.default_rng(seed)
     batch = write_night(folder, arcs)
-    out = folder / "out"
-    out.mkdir(exist_ok=True)
-    rows, t_all = [], time.perf_counter()
+    out, night = folder / "out", folder / "night"
+    rows, nights, t_all = [], [], time.perf_counter()
+    abandoned = products = 0
+
+    def night_done(seconds: float) -> None:
+        nonlocal abandoned, products
+        counts = check_night(folder, arcs)
+        abandoned, products = abandoned + counts["abandoned"], products + counts["products"]
+        nights.append({"night": len(nights) + 1, "kills": sum(r["night"] == len(nights) + 1 for r in rows),
+                       "abandoned_attempts": counts["abandoned"], "last_run_s": round(seconds, 1)})
+        say(f"night {len(nights)} complete after {nights[-1]['kills']} kill(s): every check passed, "
+            f"{counts['abandoned']} abandoned attempt(s) cleaned")
+        shutil.rmtree(out)
+        shutil.rmtree(night)
+
     with open(folder / "batch.log", "ab") as log:
-        for i in range(kills):
+        while len(rows) < kills:
+            out.mkdir(exist_ok=True)
             before = finished(out)
             delay = float(rng.uniform(min_delay, max_delay))
-            proc = start_batch(batch, log)
-            t0 = time.perf_counter()
+            proc, t0 = start_batch(batch, log), time.perf_counter()
             try:
-                proc.wait(timeout=delay)
+                rc = proc.wait(timeout=delay)
+                assert rc == 0, f"a batch run failed (rc {rc}); see {folder / 'batch.log'}"
+                night_done(time.perf_counter() - t0)
+                continue
             except subprocess.TimeoutExpired:
-                pass
-            ended = proc.poll() is not None
-            n_proc = 0 if ended else kill_group(proc)
+                n_proc = kill_group(proc)
             after = finished(out)
             lost = {a: f for a, f in before.items() if after.get(a) != f}
-            assert not lost, f"kill {i + 1}: finished arcs lost or redone: {lost}"
-            rows.append({"kill": i + 1, "delay_s": round(delay, 1), "processes_killed": n_proc,
-                         "ended_before_kill": ended, "arcs_done": len(after),
-                         "seconds": round(time.perf_counter() - t0, 1)})
-            say(f"kill {i + 1}/{kills} after {delay:.1f} s: {n_proc} processes killed, "
-                f"{len(after)}/{arcs} arcs done" + (" (batch had ended)" if ended else ""))
-        t0 = time.perf_counter()
-        proc = start_batch(batch, log)
+            assert not lost, f"kill {len(rows) + 1}: finished arcs lost or redone: {lost}"
+            rows.append({"kill": len(rows) + 1, "night": len(nights) + 1, "delay_s": round(delay, 1),
+                         "processes_killed": n_proc, "arcs_done_before": len(before), "arcs_done_after": len(after)})
+            say(f"kill {len(rows)}/{kills} (night {len(nights) + 1}) after {delay:.1f} s: {n_proc} processes "
+                f"killed, {len(after)}/{arcs} arcs done ({len(after) - len(before)} in this run)")
+        proc, t0 = start_batch(batch, log), time.perf_counter()
         rc = proc.wait()
-    final_s = time.perf_counter() - t0
     assert rc == 0, f"the last batch run failed (rc {rc}); see {folder / 'batch.log'}"
-    counts = check_night(folder, arcs)
-    summary = {"kills": kills, "arcs": arcs, "kills_that_hit_a_running_batch": sum(not r["ended_before_kill"] for r in rows),
+    night_done(time.perf_counter() - t0)
+    summary = {"kills": len(rows), "arcs": arcs, "nights": len(nights),
                "processes_killed": sum(r["processes_killed"] for r in rows),
-               "arcs_done_before_last_run": rows[-1]["arcs_done"] if rows else 0,
-               "abandoned_attempts": counts["abandoned"], "products_parsed": counts["products"],
-               "last_run_s": round(final_s, 1), "total_s": round(time.perf_counter() - t_all, 1), "per_kill": rows}
-    say(json.dumps({k: v for k, v in summary.items() if k != "per_kill"}))
+               "kills_with_arcs_finishing_before": sum(r["arcs_done_after"] > r["arcs_done_before"] for r in rows),
+               "abandoned_attempts": abandoned, "products_parsed": products,
+               "total_s": round(time.perf_counter() - t_all, 1), "per_kill": rows, "per_night": nights}
+    say(json.dumps({k: v for k, v in summary.items() if k not in ("per_kill", "per_night")}))
     return summary
 
 

@@ -206,7 +206,7 @@ def fit_arc(table: pd.DataFrame, setup: ArcSetup) -> ArcSolution:
     if not good.all():
         problem = problem_for(rows[good], times[good])
     used = rows[good]
-    sig = data_sigma(used, setup.data_sigma) / to_los[good]
+    sig = data_sigma(used, setup.data_sigma) / np.abs(to_los[good])  # a sigma <= 0 is the config's, and edited
     group = (used["observable"] + ":" + used["station_rx"].astype(str)).to_numpy(object)
     obs = Observations(times[good], used["value"].to_numpy(float), sig, group)
     x_ref = None
