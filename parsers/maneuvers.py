@@ -43,6 +43,7 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 
+from parsers.atomic import write_text
 from parsers.errors import ParseError, ParseReport, check_mode, finite, handle, integer, read_text
 
 PLAN_COLUMNS = ["name", "epoch", "kind", "frame", "dv1", "dv2", "dv3", "duration", "thrust",
@@ -246,7 +247,7 @@ def write_plan(plan: pd.DataFrame, path) -> None:
         for (_, r), t in zip(rows.iterrows(), iso):
             lines.append(",".join([str(r["name"]), t] + [_fmt(r[c]) for c in PLAN_COLUMNS[2:]]))
         text = "\n".join(lines) + "\n"
-    path.write_text(text)
+    write_text(path, text)
 
 
 # ---------------------------------------------------------------- GRAIL maneuver log

@@ -40,13 +40,13 @@ record (AGC, mode, antenna types, router, TDRSS-only bytes, ...; join on
 
 from __future__ import annotations
 
-import os
 from pathlib import Path
 
 import numpy as np
 import pandas as pd
 
 from parsers import table as tt
+from parsers.atomic import write_bytes
 from parsers.errors import ParseError, ParseReport, check_mode, handle
 from parsers.table import TrackingData
 
@@ -165,11 +165,8 @@ def _fit(name: str, col: np.ndarray, bits: int) -> np.ndarray:
 
 
 def write(path, records: pd.DataFrame) -> None:
-    """Write records (RECORD_FIELDS) to ``path`` atomically (temporary file, then rename)."""
-    path = Path(path)
-    tmp = path.with_name(path.name + ".tmp")
-    tmp.write_bytes(encode(records))
-    os.replace(tmp, path)
+    """Write records (RECORD_FIELDS) to ``path`` atomically (:mod:`parsers.atomic`)."""
+    write_bytes(path, encode(records))
 
 
 def epochs(rec: pd.DataFrame) -> np.ndarray:

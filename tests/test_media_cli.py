@@ -79,6 +79,7 @@ def test_calibrate_command_writes_table_report_and_plots(shared_data, files, cap
     np.testing.assert_allclose(out["rtlt_s"], rtlt, rtol=1e-6)
     assert sorted(p.name for p in (w / "png").iterdir()) == ["media_pass_0.png", "media_pass_1.png"]
     assert len(pd.read_csv(w / "passes.csv")) == 2
+    assert not list(w.rglob("*.part"))  # no temporary file of the atomic writer is left
 
 
 def test_calibrate_refuses_a_table_without_geometry(shared_data, files, capsys):

@@ -186,7 +186,7 @@ def plot_overlaps(summary: pd.DataFrame, path, kind: str = "pos", title: str = "
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
 
-    from odpipe.products.atomic import atomic_path
+    from odpipe.products.atomic import save_figure
 
     rows = summary[~summary["overlap"].isin(["mean", "std"])]
     labels = ["Radial", "In-track", "Cross-track", "3D RMS"]
@@ -202,6 +202,5 @@ def plot_overlaps(summary: pd.DataFrame, path, kind: str = "pos", title: str = "
     ax.legend()
     ax.grid(axis="y", alpha=0.3)
     fig.tight_layout()
-    with atomic_path(path) as tmp:
-        fig.savefig(tmp, format="png", dpi=110)
+    save_figure(path, fig, dpi=110)
     plt.close(fig)

@@ -65,6 +65,7 @@ def night_report(out: Path, arcs: list[Path], outcomes, overlap_arcs: list[Path]
 
     from odpipe.analysis.overlap import consecutive_overlaps, oem_trajectory
     from odpipe.pipeline.setup import tdb
+    from odpipe.products.atomic import write_csv
     from odpipe.runs.report import Section, write_report
 
     out.mkdir(parents=True, exist_ok=True)
@@ -84,7 +85,7 @@ def night_report(out: Path, arcs: list[Path], outcomes, overlap_arcs: list[Path]
     sections = []
     if not stats.empty:
         stats = stats[["arc"] + [c for c in stats.columns if c != "arc"]]
-        stats.to_csv(out / "residual_statistics.csv", index=False)
+        write_csv(out / "residual_statistics.csv", stats, index=False)
         sections.append(Section("Post-fit residuals per arc and station").text(
             "postfit_rms along the line of sight (m or m/s), postfit_rms_unit in the observable's unit (m, Hz, RU); "
             "per pass in each run's residual_statistics_passes.csv").table(stats))

@@ -14,6 +14,7 @@ from pathlib import Path
 import numpy as np
 
 from odpipe.commands._inputs import add_geometry_arguments, catalog, read_table, select_spacecraft, with_geometry
+from odpipe.products.atomic import write_csv
 
 NAME = "calibrate"
 HELP = "apply media calibrations (TRK-2-23 .TRO/.ION, IONEX) to a TrackingTable Parquet file"
@@ -71,7 +72,7 @@ def run(args) -> int:
                     np.datetime64(r.start, "s"), np.datetime64(r.end, "s"), r.reason, r.rows, r.of)
     store.write(args.output, out, ramps)
     if args.report:
-        report.to_csv(args.report, index=False)
+        write_csv(args.report, report, index=False)
     if args.plots:
         Path(args.plots).mkdir(parents=True, exist_ok=True)
         for pid in report["pass_id"]:

@@ -21,7 +21,7 @@ import numpy as np
 import pandas as pd
 
 from odpipe.dynamics.forces import ForceModel, SolarRadiationPressure
-from odpipe.estimation.fit import EDIT_INNOVATION, FitOptions, Observations, Solution, build_grid, fit
+from odpipe.estimation.fit import EDIT_INNOVATION, NONFINITE, FitOptions, Observations, Solution, build_grid, fit
 from odpipe.estimation.maneuvers import maneuver_table
 from odpipe.estimation.registry import GaussMarkov, ParameterRegistry
 from odpipe.measurements import MeasurementSetup
@@ -206,7 +206,7 @@ def fit_arc(table: pd.DataFrame, setup: ArcSetup) -> ArcSolution:
     if not good.all():
         problem = problem_for(rows[good], times[good])
     used = rows[good]
-    sig = data_sigma(used, setup.data_sigma) / to_los[good]
+    sig = data_sigma(used, setup.data_sigma) / np.abs(to_los[good])  # a sigma <= 0 is the config's, and edited
     group = (used["observable"] + ":" + used["station_rx"].astype(str)).to_numpy(object)
     obs = Observations(times[good], used["value"].to_numpy(float), sig, group)
     x_ref = None
@@ -248,6 +248,9 @@ def _solution(setup, reg, problem, sol, rows, times, to_los, status) -> ArcSolut
     edited = np.zeros(len(res), bool)
     edited[good] = (sol.residuals["flags"].to_numpy() & EDIT_INNOVATION) != 0
     res.loc[edited, "flags"] = int(Flag.RESIDUAL)
+    nonfinite = np.zeros(len(res), bool)
+    nonfinite[good] = (sol.residuals["flags"].to_numpy() & NONFINITE) != 0
+    res.loc[nonfinite, "flags"] |= int(Flag.NONFINITE)
     est = sol.parameters()
     params = pd.DataFrame({"name": reg.names, "kind": [p.kind for p in reg.parameters], "apriori": reg.apriori,
                            "estimate": est["estimate"].to_numpy(), "sigma": est["sigma"].to_numpy()})

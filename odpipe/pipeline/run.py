@@ -33,7 +33,7 @@ from odpipe.preprocess.compress import compress
 from odpipe.preprocess.edit import EditConfig, edit
 from odpipe.preprocess.flags import summary as flag_summary
 from odpipe.products import residuals
-from odpipe.products.atomic import write_text
+from odpipe.products.atomic import write_parquet, write_text
 from odpipe.products.oem import write_oem
 from odpipe.products.spk import write_spk
 from odpipe.runs import rundir
@@ -190,8 +190,8 @@ def unlogged_maneuvers(res: pd.DataFrame, window: int = 20, p_false: float = 1e-
 def _products(cfg, attempt, log, table, arc, edits, fit_seconds, findings) -> dict:
     res = arc.residuals
     stats = residuals.statistics(res)
-    table.to_parquet(attempt.product("tracking.parquet"))
-    res.to_parquet(attempt.product("residuals.parquet"))
+    write_parquet(attempt.product("tracking.parquet"), table)
+    write_parquet(attempt.product("residuals.parquet"), res)
     write_text(attempt.product("residual_statistics.csv"), stats.to_csv(index=False))
     per_pass = residuals.statistics(res, by=("station_rx", "observable", "pass_id"))
     write_text(attempt.product("residual_statistics_passes.csv"), per_pass.to_csv(index=False))

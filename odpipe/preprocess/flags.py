@@ -27,6 +27,7 @@ class Flag(enum.IntFlag):
     RESIDUAL = 1 << 8        # residual outlier during the fit
     PARTIAL_COUNT = 1 << 9   # compressed sample shorter than the target count time
     UPLINK = 1 << 10         # transmitted during an uplink acquisition (retune, sweep): not on the ramp table
+    NONFINITE = 1 << 11      # value, sigma, computed value or partials NaN or infinite, or sigma <= 0
 
 
 def names(value: int) -> list[str]:

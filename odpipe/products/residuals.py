@@ -11,7 +11,7 @@ from __future__ import annotations
 import numpy as np
 import pandas as pd
 
-from odpipe.products.atomic import atomic_path
+from odpipe.products.atomic import save_figure
 
 _RATE = ("doppler", "range_rate", "sst_doppler")
 
@@ -76,6 +76,5 @@ def plot(res: pd.DataFrame, path, which: str = "postfit", title: str = "") -> No
     axes[0, 0].set_title(title or f"{which.replace('fit', '-fit')} residuals along the line of sight")
     fig.autofmt_xdate()
     fig.tight_layout()
-    with atomic_path(path) as tmp:
-        fig.savefig(tmp, format="png", dpi=100)
+    save_figure(path, fig, dpi=100)
     plt.close(fig)

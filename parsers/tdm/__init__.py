@@ -12,10 +12,9 @@ DOCTYPE/ENTITY declarations are refused; KVN must be UTF-8.
 from __future__ import annotations
 
 import gc
-import os
-import tempfile
 from pathlib import Path
 
+from parsers.atomic import write_text
 from parsers.errors import ParseReport, check_mode, decode
 from parsers.table import TrackingData
 from parsers.tdm import keywords, kvn, times, xml
@@ -57,13 +56,4 @@ def write(path, data: TrackingData, syntax: str = "kvn") -> None:
     """Write ``data`` (as read by :func:`read`) as a TDM in ``syntax`` "kvn" or "xml", atomically."""
     msg: Message = message(data.table, data.meta)
     text = {"kvn": kvn.render, "xml": xml.render}[syntax](msg)
-    folder = os.path.dirname(os.path.abspath(path))
-    fd, tmp = tempfile.mkstemp(dir=folder, prefix=".tdm-")
-    try:
-        with os.fdopen(fd, "w", encoding="utf-8") as f:
-            f.write(text)
-        os.chmod(tmp, 0o644)
-        os.replace(tmp, path)
-    except BaseException:
-        os.unlink(tmp)
-        raise
+    write_text(path, text)
