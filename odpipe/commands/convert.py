@@ -36,11 +36,7 @@ def run(args) -> int:
     suffix = Path(args.output).suffix.lower()
     if suffix != ".parquet" and suffix not in TDM_SYNTAX:
         raise ValueError(f"{args.output}: cannot write {suffix!r} files: name OUT.parquet, OUT.tdm, OUT.kvn or OUT.xml")
-    try:
-        data = load(args.input, args.errors)
-    except (OSError, ValueError) as exc:  # ParseError is a ValueError; so is a file that holds no tracking data
-        print(f"error: {exc}")
-        return 1
+    data = load(args.input, args.errors)  # a ParseError, or a file with no tracking data: the CLI's one line
     if suffix == ".parquet":
         written = store.write(args.output, data.table, data.ramps)
     else:
