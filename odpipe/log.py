@@ -1,8 +1,9 @@
 """Logging of the ``odpipe`` command: progress and diagnostics on stderr, products on stdout.
 
 Modules log to ``logging.getLogger(__name__)``; the command sets the level of the ``odpipe``
-and ``parsers`` loggers (other libraries stay at WARNING). Verbosity: -1 (``-q``) warnings
-and errors, 0 progress (INFO), 1 (``-v``) detail (DEBUG, with the logger's name).
+and ``parsers`` loggers and shows other libraries' records (Dask's) only from WARNING up.
+Verbosity: -1 (``-q``) warnings and errors, 0 progress (INFO), 1 (``-v``) detail (DEBUG, with
+the logger's name).
 """
 
 from __future__ import annotations
@@ -40,6 +41,11 @@ class _Stderr(logging.StreamHandler):
         pass
 
 
+def _ours_or_warning(record: logging.LogRecord) -> bool:
+    """Progress of odpipe and parsers; of other libraries (Dask, numba), only warnings and errors."""
+    return record.name.split(".")[0] in PACKAGES or record.levelno >= logging.WARNING
+
+
 def level(verbosity: int) -> int:
     """The logging level of a verbosity (-v count minus -q count)."""
     return {1: logging.DEBUG, 0: logging.INFO, -1: logging.WARNING}.get(max(-2, min(1, verbosity)), logging.ERROR)
@@ -53,6 +59,7 @@ def configure(verbosity: int = 0, stream=None) -> None:
         root.removeHandler(_installed.pop())
     handler = logging.StreamHandler(stream) if stream is not None else _Stderr()
     handler.setFormatter(_Format())
+    handler.addFilter(_ours_or_warning)
     root.addHandler(handler)
     _installed.append(handler)
     for name in PACKAGES:

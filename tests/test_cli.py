@@ -164,3 +164,19 @@ def test_fit_iterations_are_logged_as_they_run(caplog):
     for k, (line, h) in enumerate(zip(lines, sol.history), start=1):
         assert line.startswith(f"fit iteration {k}: post-fit RMS {h['postfit_rms']:.4g} sigma "
                                f"(pre-fit {h['prefit_rms']:.4g}), {h['edited']} rows edited"), line
+
+
+def test_other_libraries_progress_stays_quiet(fake_run, capsys):
+    """Dask's INFO chatter (its loggers propagate at INFO) is not shown; its warnings are."""
+    def arc(progress):
+        logging.getLogger("distributed.scheduler").info("Receive client connection")
+        logging.getLogger("distributed.worker").warning("Worker is at 85% memory usage")
+        return {"status": "skipped", "run": "out/a/current"}
+    fake_run(arc)
+    dask, before = logging.getLogger("distributed"), logging.getLogger("distributed").level
+    dask.setLevel(logging.INFO)  # as Dask configures it
+    try:
+        assert main(["run", "arc.toml"]) == 0
+    finally:
+        dask.setLevel(before)
+    assert capsys.readouterr().err == "warning: Worker is at 85% memory usage\n"

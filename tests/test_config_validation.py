@@ -143,10 +143,12 @@ def test_malformed_and_undecodable_files(tmp_path, capsys):
 
 def test_key_line_finds_keys_tables_and_inline_entries():
     text = ('[run]\nname = "a"\n[estimation]\n"data_sigma" = { range = 1 }\n[[dynamics.gravity]]\n'
-            'body = "moon"\n[[dynamics.gravity]]\nfile = "x"\n')
+            'body = "moon"\nfile = "m"\n[[dynamics.gravity]]\nfile = "x"\n')
     assert key_line(text, "run.name") == 2
     assert key_line(text, "estimation.data_sigma.range") == 4
     assert key_line(text, "dynamics.gravity[0].body") == 6
+    assert key_line(text, "dynamics.gravity[1].file") == 9  # the second [[dynamics.gravity]]
+    assert key_line(text, "dynamics.gravity[1].degree") == 8  # missing there: its header
     assert key_line(text, "arc.start") is None
     assert key_line(text, "run.output") == 1  # a missing key: its table
 

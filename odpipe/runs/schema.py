@@ -213,24 +213,32 @@ def _expand(value, path: Path, key: str) -> list[Path]:
 
 
 def key_line(text: str, key: str) -> int | None:
-    """1-based line of ``key`` (e.g. ``dynamics.gravity[0].file``) in the TOML ``text``: the line that
-    sets it, else the one setting its nearest parent (an inline table, a table header); None if absent."""
-    want = re.sub(r"\[\d+\]", "", key).split(".")
-    table: list[str] = []
+    """1-based line of ``key`` (e.g. ``dynamics.gravity[1].file``) in the TOML ``text``: the line that
+    sets it, else the one setting its nearest parent (an inline table, a table header); None if absent.
+    An index counts the ``[[array]]`` headers of that array; on a plain array it is ignored."""
+    want = [(m.group(1), int(m.group(2)) if m.group(2) else None)
+            for m in (re.fullmatch(r"(.*?)(?:\[(\d+)\])?", part) for part in _parts(key))]
+    seen: dict[tuple, int] = {}
+    table: list[tuple] = []
     best, best_len = None, 0
     for no, raw in enumerate(text.splitlines(), start=1):
         line = raw.strip()
-        header = re.match(r"^\[\[?\s*([^\]]+?)\s*\]\]?", line)
+        header = re.match(r"^(\[\[?)\s*([^\]]+?)\s*\]", line)
         if header:
-            table = _parts(header.group(1))
+            names = _parts(header.group(2))
+            index = None
+            if header.group(1) == "[[":
+                index = seen[tuple(names)] = seen.get(tuple(names), -1) + 1
+            table = [(n, None) for n in names[:-1]] + [(names[-1], index)]
             here = table
         else:
             m = re.match(r"^([A-Za-z0-9_\-\"'. ]+?)\s*=", line)
             if not m:
                 continue
-            here = table + _parts(m.group(1))
+            here = table + [(n, None) for n in _parts(m.group(1))]
         n = len(here)
-        if n > best_len and want[:n] == here:
+        if n > best_len and n <= len(want) and all(
+                a == w and (i is None or j is None or i == j) for (a, i), (w, j) in zip(here, want)):
             best, best_len = no, n
             if n == len(want):
                 break
