@@ -175,7 +175,8 @@ def _toml_rows(text: str, path) -> tuple[list, list]:
         doc = tomllib.loads(text)
     except (tomllib.TOMLDecodeError, ValueError, RecursionError) as exc:  # ValueError: e.g. a 5000-digit integer
         at = re.search(r"at line (\d+)", str(exc))
-        raise ParseError(path, f"TOML: {str(exc)[:200]}", line=int(at[1]) if at else None) from None
+        raise ParseError(path, f"TOML: {str(exc)[:200]}",
+                         line=int(at[1]) if at else text.count("\n") + 1) from None
     if set(doc) != {"maneuver"} or not isinstance(doc["maneuver"], list):
         raise ParseError(path, f"a plan holds only [[maneuver]] tables, not {sorted(doc)[:5]}")
     rows = []
@@ -186,7 +187,10 @@ def _toml_rows(text: str, path) -> tuple[list, list]:
                 vec = m.pop(key)
                 m.update(dict(zip(cols, vec)) if isinstance(vec, list) and len(vec) == 3 else {f"{key} (3 numbers)": vec})
         rows.append(m)
-    return rows, [{"record": i} for i in range(len(rows))]
+    starts = [n for n, ln in enumerate(text.splitlines(), 1) if ln.strip() == "[[maneuver]]"]
+    if len(starts) != len(rows):  # tables written another way: no line to name
+        starts = [None] * len(rows)
+    return rows, [{"line": n, "record": i} for i, n in enumerate(starts)]
 
 
 def _csv_rows(text: str, path, errors, report) -> tuple[list, list]:

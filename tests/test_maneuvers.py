@@ -149,3 +149,14 @@ def test_grail_log_bad_byte_and_bad_lines(shared_data, tmp_path):
     assert len(log) == 174 - 3 and [e.line for e in report] == [6, 7, 8]
     with pytest.raises(ParseError):
         read_mas(p)
+
+
+def test_bad_toml_row_names_its_table_line(tmp_path):
+    p = tmp_path / "plan.toml"
+    write_plan(plan(), p)
+    text = p.read_text().replace("kind = \"finite\"", "kind = \"finit\"")
+    p.write_text(text)
+    with pytest.raises(ParseError, match="kind") as err:
+        read_plan(p)
+    assert text.splitlines()[err.value.line - 1] == "[[maneuver]]" and err.value.record == 1
+    assert err.value.line == [n for n, ln in enumerate(text.splitlines(), 1) if ln == "[[maneuver]]"][1]
