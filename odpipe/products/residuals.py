@@ -67,8 +67,9 @@ def _count(rows: pd.DataFrame, by: list, index) -> np.ndarray:
 
 def report_tables(stats: pd.DataFrame) -> list[tuple[str, pd.DataFrame, dict]]:
     """(caption, table, formats) per observable and unit of a :func:`statistics` table for a report:
-    residuals in the display unit (mm/s or m, :func:`display_scale`), the unit in each column name,
-    RMS to 4 significant figures. Columns before ``n_used`` (e.g. arc, station, pass) lead."""
+    residuals in the display unit (:func:`display_scale`) to 0.1 µm/s or 1 mm, in the observable's unit
+    to 4 significant figures, the unit in each column name. Columns before ``n_used`` (e.g. arc,
+    station, pass) lead."""
     keys = [c for c in stats.columns[: list(stats.columns).index("n_used")] if c != "observable"]
     out = []
     for (obs, unit), sub in stats.groupby(["observable", stats.get("obs_unit", pd.Series("", index=stats.index))],
@@ -83,7 +84,9 @@ def report_tables(stats: pd.DataFrame) -> list[tuple[str, pd.DataFrame, dict]]:
         t[f"post-fit RMS ({shown})"] = sub["postfit_rms"] * scale
         if unit:
             t[f"post-fit RMS ({unit})"] = sub["postfit_rms_obs"]
-        fmt = {c: "{:.4g}" for c in t.columns if "RMS" in c or "mean" in c}
+        fmt = {c: ("{:.4f}" if shown == "mm/s" else "{:.3f}") for c in t.columns if f"({shown})" in c}
+        if unit:
+            fmt[f"post-fit RMS ({unit})"] = "{:.4g}"
         out.append((f"{obs}" + (f" (observed in {unit})" if unit else ""), t, fmt))
     return out
 
