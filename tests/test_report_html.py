@@ -98,6 +98,16 @@ def test_run_report_keeps_the_rules(run):
     assert "class='scroll'" in page  # wide tables scroll inside the page
 
 
+def test_night_report_keeps_the_rules(run):
+    from odpipe.commands.batch import night_report
+    from odpipe.runs.batch import ArcOutcome
+
+    tmp, _ = run
+    page = night_report(tmp / "night", [tmp / "arc.toml"], [ArcOutcome(str(tmp / "arc.toml"), "complete", 1.0)])
+    text = page.read_text()
+    assert broken_rules(text) == [] and "post-fit RMS (mm/s)" in text
+
+
 def test_prefit_residuals_are_the_a_prioris_first_iteration(run):
     """The pre-fit residuals (observed - computed on the a priori, from the models' reference) whitened
     equal the fit's own first-iteration pre-fit RMS in the run log, and are far above the post-fit."""
