@@ -22,6 +22,7 @@ from parsers import oem
 _J2000 = np.datetime64("2000-01-01T12:00:00", "ns")
 
 COMPONENTS = ("radial", "intrack", "crosstrack")
+EDGE = 2e-6  # s: products start and end on whole microseconds inside their arc (pipeline.products.product_epochs)
 
 
 class SampledTrajectory:
@@ -43,7 +44,7 @@ class SampledTrajectory:
 
     def state(self, t_tdb):
         t = np.atleast_1d(np.asarray(t_tdb, dtype=float))
-        if np.any(t < self.t0 - 1e-6) or np.any(t > self.t1 + 1e-6):
+        if np.any(t < self.t0 - EDGE) or np.any(t > self.t1 + EDGE):
             raise ValueError(f"epoch outside the trajectory span [{self.t0}, {self.t1}] s TDB")
         return np.hstack([self._spline(t), self._dspline(t)])
 

@@ -260,8 +260,8 @@ def _sections(cfg, res, stats, per_pass, edits, params, figures, findings, man_r
     if len(findings):
         detected.table(findings[["after", "epoch", "statistic", "threshold"]].rename(
             columns={"after": "last quiet row (UTC)", "epoch": "first excess row (UTC)",
-                     "statistic": "chi-square", "threshold": "threshold (chi-square)"}),
-            {"chi-square": "{:.1f}", "threshold (chi-square)": "{:.1f}"})
+                     "statistic": "window sum (chi-square)", "threshold": "threshold (chi-square)"}),
+            {"window sum (chi-square)": "{:.1f}", "threshold (chi-square)": "{:.1f}"})
     sections.append(detected)
     if man_stats is not None:
         sections.append(Section("Maneuvers (designed − estimated)").tables(

@@ -55,15 +55,15 @@ def _round(t: np.ndarray, unit: str) -> np.ndarray:
 
 
 def _cell(value, fmt) -> str:
-    if value is None or (isinstance(value, (float, np.floating)) and not np.isfinite(value)):
+    if value is None or (np.ndim(value) == 0 and not isinstance(value, str) and pd.isna(value)):
+        return MISSING
+    if isinstance(value, (float, np.floating)) and not np.isfinite(value):
         return MISSING
     if isinstance(value, (np.datetime64, pd.Timestamp)):
-        if pd.isna(value):
-            return MISSING
         return np.datetime_as_string(_round(np.array([np.datetime64(value, "ns")]), "s")[0], unit="s")
     if isinstance(value, (bool, np.bool_)):
         return "yes" if value else "no"
-    if isinstance(value, (float, np.floating, int, np.integer)) and not isinstance(value, (bool, np.bool_)):
+    if isinstance(value, (float, np.floating, int, np.integer)):
         if callable(fmt):
             return fmt(value)
         return (fmt or ("{:d}" if isinstance(value, (int, np.integer)) else "{:.6g}")).format(value)
