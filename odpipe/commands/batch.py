@@ -63,8 +63,9 @@ def night_report(out: Path, arcs: list[Path], outcomes, overlap_arcs: list[Path]
     arcs among ``overlap_arcs`` (default all)."""
     import pandas as pd
 
-    from odpipe.analysis.overlap import consecutive_overlaps, oem_trajectory
+    from odpipe.analysis.overlap import consecutive_overlaps, oem_trajectory, report_tables
     from odpipe.pipeline.setup import tdb
+    from odpipe.products import residuals
     from odpipe.products.atomic import write_csv
     from odpipe.runs.report import Section, write_report
 
@@ -87,13 +88,14 @@ def night_report(out: Path, arcs: list[Path], outcomes, overlap_arcs: list[Path]
         stats = stats[["arc"] + [c for c in stats.columns if c != "arc"]]
         write_csv(out / "residual_statistics.csv", stats, index=False)
         sections.append(Section("Post-fit residuals per arc and station").text(
-            "postfit_rms along the line of sight (m or m/s), postfit_rms_unit in the observable's unit (m, Hz, RU); "
-            "per pass in each run's residual_statistics_passes.csv").table(stats))
+            "Along the line of sight (Doppler mm/s, range m), and the post-fit RMS in the observable's unit; "
+            "per pass in each run's residual_statistics_passes.csv").tables(residuals.report_tables(stats)))
     seq = [(name, run) for _, name, run, a in done if overlap_arcs is None or a in overlap_arcs]
     table, pngs = consecutive_overlaps({name: oem_trajectory(run / "trajectory.oem") for name, run in seq},
                                        [name for name, _ in seq], out, "arcs", "Consecutive-arc", step=60.0)
     if table is not None:
-        sec = Section("Overlaps of consecutive arcs (RIC differences, A - B over each overlap)").table(table)
+        sec = Section("Overlaps of consecutive arcs (RIC differences, A - B over each overlap)").tables(
+            report_tables(table))
         for png in pngs:
             sec.figure(png, png.stem)
         sections.append(sec)

@@ -56,7 +56,7 @@ def plot_convergence(out: Path, name: str, panels: list[dict], ylabel: str, ncol
             ax.semilogy(p["t_days"] if "t" not in style else style["t"], y,
                         **{k: v for k, v in style.items() if k != "t"}, label=label)
         ax.set_title(p["title"], fontsize=9)
-        ax.set_xlabel("days")
+        ax.set_xlabel("time (days)")
         ax.grid(True, which="both", alpha=0.3)
     for row in axes:
         row[0].set_ylabel(ylabel)
