@@ -86,7 +86,7 @@ def test_oem_reader_names_bad_line(tmp_path, segment):
     path.write_text("\n".join(lines))
     with pytest.raises(ParseError) as err:
         oem_reader.read(path)
-    assert err.value.line == k + 1 and "bad number" in err.value.reason
+    assert err.value.line == k + 1 and "is not a number" in err.value.reason
 
 
 def test_spk_read_back_by_spice(tmp_path, segment):
