@@ -180,3 +180,16 @@ def test_other_libraries_progress_stays_quiet(fake_run, capsys):
     finally:
         dask.setLevel(before)
     assert capsys.readouterr().err == "warning: Worker is at 85% memory usage\n"
+
+
+def test_apriori_refuses_a_run_that_is_not_about_the_moon(tmp_path, capsys):
+    """`odpipe apriori` on the peers' Earth-orbit case: one line naming the config and its centre, status 2."""
+    from heo_case import write_config
+
+    import pandas as pd
+
+    write_config(tmp_path, "heo", "2003-06-03T00:00:00", "2003-06-03T06:00:00", [7e6, 0, 0, 0, 7.5e3, 0], "")
+    pd.DataFrame({"epoch": []}).to_parquet(tmp_path / "tracking.parquet")  # never read: the centre is refused first
+    assert main(["apriori", str(tmp_path / "arc.toml")]) == 2
+    err = capsys.readouterr().err.strip()
+    assert err.count("\n") == 0 and "arc.toml" in err and "dynamics.center" in err and "lunar orbiter" in err
