@@ -180,3 +180,15 @@ def test_other_libraries_progress_stays_quiet(fake_run, capsys):
     finally:
         dask.setLevel(before)
     assert capsys.readouterr().err == "warning: Worker is at 85% memory usage\n"
+
+
+def test_simulate_case_errors_name_the_file_and_key(tmp_path, capsys):
+    text = (ROOT / "runs" / "artemis_p2_like.toml").read_text()
+    (tmp_path / "noseed.toml").write_text("\n".join(ln for ln in text.splitlines() if not ln.startswith("seed")))
+    assert main(["simulate", str(tmp_path / "noseed.toml"), "-o", str(tmp_path / "out")]) == 2
+    assert _stderr_lines(capsys) == [f"error: {tmp_path / 'noseed.toml'}: [seed] required key is missing"]
+    (tmp_path / "pass.toml").write_text(text.replace("\npass_s =", "\npass_sec ="))
+    assert main(["simulate", str(tmp_path / "pass.toml"), "-o", str(tmp_path / "out")]) == 2
+    assert _stderr_lines(capsys) == [f"error: {tmp_path / 'pass.toml'}: [network] got an unexpected keyword "
+                                     "argument 'pass_sec'"]
+    assert not (tmp_path / "out").exists()
