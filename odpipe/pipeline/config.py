@@ -12,7 +12,10 @@ with its line.
 
 from __future__ import annotations
 
+import functools
+import importlib
 import re
+import typing
 import warnings
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -22,7 +25,16 @@ import numpy as np
 
 from odpipe.runs.schema import (at_least, between, checked, file_name, internal, load, positive, read_toml,
                                 readable, readable_files)
-TRACKING_READERS = ("parsers.odf", "parsers.utdf", "parsers.trk234", "parsers.tdm")  # formats.READERS of tracking
+
+
+@functools.cache
+def tracking_readers() -> tuple[str, ...]:
+    """The reader modules of :mod:`parsers.formats` whose ``read`` returns TrackingData."""
+    from parsers import formats
+    from parsers.table import TrackingData
+
+    return tuple(n for n in formats.available()
+                 if typing.get_type_hints(importlib.import_module(n).read).get("return") is TrackingData)
 
 
 def utc_time(value: str) -> list[tuple[str, str]]:
@@ -63,23 +75,23 @@ def _recognised(path: Path, readers: tuple[str, ...], what: str) -> str | None:
                                                 "no reader recognises it)")
 
 
-def _files_of(readers: tuple[str, ...], what: str):
-    """Check: a path (or every path of a list) is a readable file of one of ``readers``."""
+def _files_of(readers, what: str):
+    """Check: a path (or every path of a list) is a readable file of one of ``readers()``."""
     return lambda paths: [("", why) for p in (paths if isinstance(paths, list) else [paths])
-                          if (why := _recognised(p, readers, what))]
+                          if (why := _recognised(p, readers(), what))]
 
 
 @dataclass
 class RunSection:
-    name: str = checked(file_name)  # one folder name: runs go to OUTPUT/NAME (attempt folders and 'current')
-    output: Path = Path("out")  # folder of the run folders
+    name: str = checked(file_name)  # a plain folder name (no '/', '..'): the run's folder is OUTPUT/NAME
+    output: Path = Path("out")  # runs go to OUTPUT/NAME (attempt folders and 'current')
 
 
 @dataclass
 class ArcSection:
     spacecraft: str  # id as the tracking files give it, e.g. "181"
-    start: str = checked(utc_time)  # UTC ISO time: the arc (fit span) starts
-    end: str = checked(utc_time)  # UTC ISO time, after start
+    start: str = checked(utc_time)  # UTC ISO time, e.g. "2012-04-09T04:00:00"
+    end: str = checked(utc_time)  # UTC ISO time, after the start
 
     def problems(self):
         if _utc(self.end) <= _utc(self.start):
@@ -88,8 +100,8 @@ class ArcSection:
 
 @dataclass
 class DataSection:
-    # tracking files or globs (ODF, TRK-2-34, UTDF, TDM, or TrackingTable Parquet), read and merged
-    files: list[Path] = checked(_files_of(TRACKING_READERS, "tracking"))
+    # tracking files (globs allowed): any format parsers.formats reads as tracking data, or TrackingTable .parquet
+    files: list[Path] = checked(_files_of(tracking_readers, "tracking"))
     # station CSVs added to the default catalog
     stations: list[Path] = checked(readable_files, default_factory=list)
     # observables fitted; "observable:BAND" keeps only rows of that downlink band (e.g. "doppler_1way:X")
@@ -101,11 +113,11 @@ class DataSection:
 class CalibrationSection:
     media: bool = True  # false: the table's values are already corrected (or simulated without media)
     # DSN TRK-2-23 troposphere cards (.TRO); without them the DSN seasonal model (or Saastamoinen)
-    tro: list[Path] = checked(_files_of(("parsers.trk223",), "TRK-2-23"), default_factory=list)
+    tro: list[Path] = checked(_files_of(lambda: ("parsers.trk223",), "TRK-2-23"), default_factory=list)
     # DSN TRK-2-23 ionosphere cards (.ION)
-    ion: list[Path] = checked(_files_of(("parsers.trk223",), "TRK-2-23"), default_factory=list)
+    ion: list[Path] = checked(_files_of(lambda: ("parsers.trk223",), "TRK-2-23"), default_factory=list)
     # IONEX maps (TEC -> delay at each leg's frequency), where no .ION card covers
-    ionex: list[Path] = checked(_files_of(("parsers.ionex",), "IONEX"), default_factory=list)
+    ionex: list[Path] = checked(_files_of(lambda: ("parsers.ionex",), "IONEX"), default_factory=list)
     smoothing_order: int = checked(at_least(-1), default=10)  # per-pass polynomial; -1 = none
 
 
@@ -204,7 +216,7 @@ class EstimationSection:
     # y1 (1/s) about the arc start, one pair for every band it drives (a priori 0: the rows' reference)
     oscillator_sigma: list[float] | None = checked(positive, default=None)
     # planned maneuvers (parsers.maneuvers schema)
-    maneuver_plan: Path | None = checked(_files_of(("parsers.maneuvers",), "maneuver plan"), default=None)
+    maneuver_plan: Path | None = checked(_files_of(lambda: ("parsers.maneuvers",), "maneuver plan"), default=None)
     # s: estimate planned burns' epochs (a plan's sigma_time wins)
     maneuver_epoch_sigma: float | None = checked(positive, default=None)
     # innovation editing threshold (sigmas) per iteration, the last repeated; inf edits nothing
