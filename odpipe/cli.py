@@ -1,7 +1,9 @@
 """The ``odpipe`` command. Each subcommand is a module in :mod:`odpipe.commands`.
 
-A command module defines ``NAME`` (str), ``HELP`` (one line),
+A command module defines ``NAME`` (str), ``HELP`` (one line), both string literals,
 ``add_arguments(parser)`` and ``run(args) -> int`` (exit status, :class:`odpipe.errors.Exit`).
+The list of commands is read from the modules' source; only the command being run is imported,
+so ``odpipe --help`` does not wait for the whole pipeline to load.
 Its product (a summary table, the path of a report) goes to stdout; progress and
 diagnostics go through :mod:`logging` to stderr (:mod:`odpipe.log`). An expected error
 raised by a command becomes one line on stderr and its exit status (:mod:`odpipe.errors`).
@@ -10,10 +12,12 @@ raised by a command becomes one line on stderr and its exit status (:mod:`odpipe
 from __future__ import annotations
 
 import argparse
+import ast
 import importlib
 import logging
 import pkgutil
 import sys
+from pathlib import Path
 
 import odpipe.commands
 from odpipe import log
@@ -22,10 +26,17 @@ from odpipe.errors import MEANING, Exit, describe
 _log = logging.getLogger("odpipe")
 
 
-def _command_modules():
+def commands() -> dict[str, tuple[str, str]]:
+    """Command name -> (module, one-line help), read from each command module's NAME and HELP literals."""
+    out = {}
     for info in sorted(pkgutil.iter_modules(odpipe.commands.__path__), key=lambda i: i.name):
-        if not info.name.startswith("_"):
-            yield importlib.import_module(f"odpipe.commands.{info.name}")
+        if info.name.startswith("_"):
+            continue
+        tree = ast.parse((Path(odpipe.commands.__path__[0]) / f"{info.name}.py").read_text())
+        consts = {t.id: ast.literal_eval(node.value) for node in tree.body if isinstance(node, ast.Assign)
+                  for t in node.targets if isinstance(t, ast.Name) and t.id in ("NAME", "HELP")}
+        out[consts["NAME"]] = (f"odpipe.commands.{info.name}", consts["HELP"])
+    return out
 
 
 def _global_options(parser: argparse.ArgumentParser, top: bool) -> None:
@@ -43,7 +54,9 @@ def exit_status_table() -> str:
     return "exit status:\n" + "\n".join(f"  {int(code):<4}{text}" for code, text in MEANING.items())
 
 
-def build_parser() -> argparse.ArgumentParser:
+def build_parser(command: str | None = None) -> argparse.ArgumentParser:
+    """The parser of every command; only ``command``'s module is imported and its arguments added (all
+    commands' when None)."""
     parser = argparse.ArgumentParser(prog="odpipe",
                                      description="Orbit-determination post-processing of radiometric tracking data.",
                                      epilog=exit_status_table(),
@@ -51,17 +64,25 @@ def build_parser() -> argparse.ArgumentParser:
     parser.add_argument("--version", action="version", version=f"odpipe {odpipe.__version__}")
     _global_options(parser, top=True)
     sub = parser.add_subparsers(dest="command", metavar="COMMAND")
-    for mod in _command_modules():
-        p = sub.add_parser(mod.NAME, help=mod.HELP.replace("%", "%%"), description=mod.HELP)  # help is %-formatted
-        mod.add_arguments(p)
+    for name, (module, text) in commands().items():
+        p = sub.add_parser(name, help=text.replace("%", "%%"), description=text)  # help is %-formatted
+        if command in (None, name):
+            mod = importlib.import_module(module)
+            mod.add_arguments(p)
+            p.set_defaults(_run=mod.run)
         _global_options(p, top=False)
-        p.set_defaults(_run=mod.run)
     return parser
+
+
+def _command_in(argv: list[str]) -> str | None:
+    """The command named in ``argv``: its first word that is not an option (global options take no value)."""
+    return next((a for a in argv if not a.startswith("-")), None)
 
 
 def main(argv: list[str] | None = None) -> int:
     """Run ``odpipe`` with ``argv`` (default: the process's); returns the exit status."""
-    parser = build_parser()
+    argv = sys.argv[1:] if argv is None else list(argv)
+    parser = build_parser(_command_in(argv) or "")
     args = parser.parse_args(argv)
     log.configure(1 if args.debug else args.verbose - args.quiet)
     if not hasattr(args, "_run"):  # bare `odpipe`: what it can do
