@@ -54,7 +54,7 @@ from odpipe.frames.tabulated import TabulatedRotation
 from odpipe.preprocess.timetags import interval_bounds
 
 from . import angles, crosslink, dsn, instantaneous
-from .bands import ONE_WAY_SCALE, band_name, range_unit_factor, turnaround_ratio
+from .bands import C_LIGHT, ONE_WAY_SCALE, band_name, range_unit_factor, turnaround_ratio
 from .computed import Computed, ConstantUplink
 from .lighttime import anchor_from_utc, solve_path
 from .nodes import SpacecraftNode, StationNode, proper_rate_offset
@@ -70,6 +70,8 @@ class MeasurementSetup:
     oscillators: spacecraft -> (y0, y1 1/s, t_ref TDB s) of its one-way oscillator: fractional frequency
     offset from each row's reference frequency and its drift (:func:`.dsn.one_way_doppler`).
     clocks: spacecraft -> :class:`.crosslink.ClockModel` for dual one-way ranging.
+    com_offsets: spacecraft -> centre-of-mass offset (m) of its ranging reflector or antenna towards the
+    stations (LAGEOS: 0.251 m): each leg of a ``range`` row is that much shorter than to the centre of mass.
     """
 
     ephemeris: object
@@ -82,6 +84,7 @@ class MeasurementSetup:
     media_in_model: bool = True
     oscillators: dict = field(default_factory=dict)
     clocks: dict = field(default_factory=dict)
+    com_offsets: dict = field(default_factory=dict)
 
     @classmethod
     def default(cls, **kw) -> "MeasurementSetup":
@@ -183,6 +186,7 @@ def _evaluate(key, g, trajectories, setup):
             ru = range_unit_factor(g["band_up"].to_numpy(object))
             modulus = _column(g, ("range_modulus", "range_modulus_ru"))
             delay = np.nan_to_num(g["delay_s"].to_numpy(float)) if "delay_s" in g.columns else 0.0
+            delay = delay - 2.0 * setup.com_offsets.get(sc, 0.0) / C_LIGHT
             if unit not in ("RU", "m", "s"):
                 raise _Unsupported(f"range in unit {unit!r}: only RU, m and s are modelled")
             return dsn.dsn_range(solve(nodes, epoch), up, tx, epoch, ru, unit, delay, modulus), roles
