@@ -123,7 +123,7 @@ class ArcSolution:
 ANGLE_UNITS = {"rad": 1.0, "deg": np.pi / 180.0, "mdeg": np.pi / 180e3, "arcsec": np.pi / 648e3}
 
 
-def _sigma(key: str, value) -> float:
+def sigma_value(key: str, value) -> float:
     """A data_sigma entry as a number: angles may carry their unit ("0.01 deg"); bare numbers as given."""
     if not isinstance(value, str):
         return float(value)
@@ -137,7 +137,7 @@ def _sigma(key: str, value) -> float:
 def data_sigma(rows: pd.DataFrame, sigmas: dict) -> np.ndarray:
     """Per-row sigma (m or m/s; rad for angle rows): the "observable:station_rx" entry if there is one, else
     the observable's."""
-    sigmas = {k: _sigma(k, v) for k, v in sigmas.items()}
+    sigmas = {k: sigma_value(k, v) for k, v in sigmas.items()}
     by_station = (rows["observable"] + ":" + rows["station_rx"].astype(str)).map(sigmas)
     return by_station.fillna(rows["observable"].map(sigmas)).to_numpy(float)
 
