@@ -96,3 +96,19 @@ def test_angle_sigmas_carry_their_unit():
         data_sigma(rows, {"range": "2 m"})
     with pytest.raises(ValueError, match="one of"):
         data_sigma(rows, {"angle_az": "0.01 degrees"})
+
+
+def test_run_config_takes_angle_sigmas_with_units(tmp_path):
+    from odpipe.pipeline.config import load_config
+    from odpipe.runs.schema import ConfigError
+    from tests.heo_case import write_config
+
+    write_config(tmp_path, "angles", "2003-06-01T00:05:00", "2003-06-01T02:00:00", np.r_[R0, V0])
+    text = (tmp_path / "arc.toml").read_text()
+    good = 'data_sigma = { range = 1.0, angle_az = "0.01 deg", angle_el = 1.7e-4 }'
+    (tmp_path / "arc.toml").write_text(text.replace("data_sigma = { range = 1.0, doppler_2way = 1e-4 }", good))
+    assert load_config(tmp_path / "arc.toml").estimation.data_sigma["angle_az"] == "0.01 deg"
+    (tmp_path / "arc.toml").write_text(text.replace("data_sigma = { range = 1.0, doppler_2way = 1e-4 }",
+                                                    'data_sigma = { range = "1 m" }'))
+    with pytest.raises(ConfigError, match=r"estimation\.data_sigma\.range.*only angle observables take a unit"):
+        load_config(tmp_path / "arc.toml")

@@ -43,3 +43,32 @@ def test_dispersion_follows_the_wavelength():
     d532 = mp.slant_delay(np.pi / 2, np.radians(45), 0.0, 1013.25e2, 288.15, 50.0, 532.0)
     d1064 = mp.slant_delay(np.pi / 2, np.radians(45), 0.0, 1013.25e2, 288.15, 50.0, 1064.0)
     assert 2.44 < d532 < 2.46 and 0.95 < d1064 / d532 < 0.96
+
+
+def test_laser_rows_get_it_from_their_own_meteo_in_calibrate():
+    from odpipe.environment.stations import StationCatalog, itrs_to_geodetic, topocentric
+    from odpipe.media import saastamoinen
+    from odpipe.media.apply import calibrate
+    from odpipe.media.model import MediaModel
+    from parsers import table as tt
+
+    st = StationCatalog.default()["DSS-25"]
+    lat, _, h = itrs_to_geodetic(st.r_itrs)
+    sat = st.r_itrs * 1.6                                         # fixed in ITRS above the site: one elevation
+    _, el, _ = topocentric(st, sat, None)
+    ep = np.datetime64("2016-02-13T12:00", "ns") + np.arange(3) * np.timedelta64(60, "s")
+    rows = tt.build(3, epoch=ep, tag="receive", observable="range", unit="m", value=7e6, station_tx="DSS-25",
+                    station_rx="DSS-25", spacecraft="sat", wavelength_nm=[532.0, 1064.0, np.nan],
+                    pressure_mbar=[900.0, np.nan, 900.0], temperature_k=290.0, humidity_pct=40.0)
+    out, _ = calibrate(rows, MediaModel(), target_itrs=lambda t: np.broadcast_to(sat, (np.size(t), 3)), order=None)
+    one_way = mp.slant_delay(el, lat, h, 900e2, 290.0, 40.0, 532.0)
+    assert out["tropo_m"].iloc[0] == pytest.approx(2 * one_way, abs=1e-9)         # both legs, row's meteo
+    p, t, e = saastamoinen.standard_atmosphere(h)                                  # no pressure: standard
+    dry, wet = mp.zenith_delays(p, e, lat, h, 1064.0)
+    assert out["tropo_m"].iloc[1] == pytest.approx(2 * (dry + wet) * mp.mapping(el, lat, h, t), abs=1e-9)
+    assert (out["iono_m"].iloc[:2] == 0).all()
+    assert list(out["media_source"].astype(str)) == [
+        "tropo: Mendes-Pavlis (row meteo) | iono: not at optical wavelengths",
+        "tropo: Mendes-Pavlis (no meteo) | iono: not at optical wavelengths",
+        "tropo: DSN-seasonal (no TRO) | iono: none"]                              # a radio row: as before
+    assert out["media_note"].iloc[1] == "laser row without meteorology: standard atmosphere used"

@@ -216,7 +216,7 @@ def _optical(table, rows, elevation, lat, h):
     lam = np.where(laser, table["wavelength_nm"].to_numpy(dtype=float)[rows], 532.0)
     dry, wet = mendes_pavlis.zenith_delays(p, e, lat, h, lam)
     delay = (dry + wet) * mendes_pavlis.mapping(elevation, lat, h, t)
-    label = np.where(measured, "Mendes-Pavlis (row meteo)", "Mendes-Pavlis standard-atmosphere")
+    label = np.where(measured, "Mendes-Pavlis (row meteo)", "Mendes-Pavlis (no meteo)")
     return laser, delay, label.astype(object)
 
 
@@ -252,6 +252,7 @@ def _notes(n, rows, code, texts, ground, two_leg, rtlt_note):
     """Per row: why its correction is partial or a fallback (from every sample's source text)."""
     reasons = [("(no TRO)", "no TRO coverage: DSN seasonal model used"),
                ("standard-atmosphere", "non-DSN station: standard atmosphere used"),
+               ("(no meteo)", "laser row without meteorology: standard atmosphere used"),
                ("iono: none", "no ionosphere calibration: none applied"),
                ("no direction", "no spacecraft direction or below horizon: no correction"),
                ("no station", "station not in catalog: no correction")]

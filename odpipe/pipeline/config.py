@@ -13,6 +13,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Literal
 
+from odpipe.od.arc import sigma_value
 from odpipe.runs.schema import ConfigError, load
 
 
@@ -115,8 +116,9 @@ class EstimationSection:
     sigma_velocity: float = 1.0
     srp_scale_sigma: float | None = 0.1
     stochastic: StochasticSection | None = None
-    # LOS sigma (m, m/s) by "observable" or "observable:station" (the station's entry wins)
-    data_sigma: dict[str, float] = field(default_factory=lambda: {"range": 2.0, "doppler_2way": 1e-4})
+    # LOS sigma (m, m/s) by "observable" or "observable:station" (the station's entry wins); angle observables:
+    # the angle's sigma, rad or with its unit ("0.01 deg", "36 arcsec")
+    data_sigma: dict[str, float | str] = field(default_factory=lambda: {"range": 2.0, "doppler_2way": 1e-4})
     range_bias_sigma: float | None = 5.0
     # one-way Doppler's oscillator, estimated when set: sigmas of its fractional frequency offset y0 and drift
     # y1 (1/s) about the arc start, one pair for every band it drives (a priori 0: the rows' reference)
@@ -177,6 +179,11 @@ def load_config(path) -> RunConfig:
         raise ConfigError(path, "initial_state", "give either state or from_oem")
     if init.state is not None and len(init.state) != 6:
         raise ConfigError(path, "initial_state.state", "needs 6 numbers (m, m/s)")
+    for key, value in cfg.estimation.data_sigma.items():
+        try:
+            sigma_value(key, value)
+        except ValueError as exc:
+            raise ConfigError(path, f"estimation.data_sigma.{key}", str(exc)) from None
     cfg.path, cfg.text = path, text
     return cfg
 
