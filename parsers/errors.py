@@ -1,6 +1,12 @@
-"""The one exception every reader raises for malformed input."""
+"""The one exception every reader raises for malformed input, and the checks every reader shares."""
 
 from __future__ import annotations
+
+import math
+import re
+from pathlib import Path
+
+_INTEGER = re.compile(r"[-+]?\d{1,18}", re.ASCII)
 
 
 class ParseError(ValueError):
@@ -64,3 +70,43 @@ def handle(err: ParseError, errors: str, report: ParseReport | None) -> None:
         raise err
     if report is not None:
         report.add(err)
+
+
+def read_text(path, encoding: str = "utf-8") -> str:
+    """The text of file ``path``: ParseError when it is empty (or blank) or not ``encoding`` (byte offset)."""
+    return decode(Path(path).read_bytes(), path, encoding)
+
+
+def decode(raw: bytes, path, encoding: str = "utf-8") -> str:
+    """``raw`` decoded strictly; ParseError naming the first bad byte, or an empty (blank) file."""
+    try:
+        text = raw.decode(encoding)
+    except UnicodeDecodeError as exc:
+        line = raw.count(b"\n", 0, exc.start) + 1
+        raise ParseError(path, f"byte {raw[exc.start:exc.start + 1]!r} is not {encoding} text",
+                         offset=exc.start, line=line) from None
+    if not text.strip():
+        raise ParseError(path, "empty file", offset=0)
+    return text
+
+
+def finite(text: str, path, what: str, **where) -> float:
+    """``text`` as a finite float; ParseError (naming ``what`` and ``where``) for anything else (1e400, nan)."""
+    try:
+        value = float(text)
+    except (ValueError, TypeError):
+        raise ParseError(path, f"{what}: {str(text)[:40]!r} is not a number", **where) from None
+    if not math.isfinite(value):
+        raise ParseError(path, f"{what}: {str(text)[:40]!r} is not a finite number", **where)
+    return value
+
+
+def integer(text: str, path, what: str, lo: int, hi: int, **where) -> int:
+    """``text`` as an integer in [lo, hi]; ParseError otherwise (also for 5000-digit numbers)."""
+    s = str(text).strip()
+    if not _INTEGER.fullmatch(s):
+        raise ParseError(path, f"{what}: {s[:40]!r} is not an integer", **where)
+    value = int(s)
+    if not lo <= value <= hi:
+        raise ParseError(path, f"{what}: {value} is outside [{lo}, {hi}]", **where)
+    return value

@@ -12,12 +12,13 @@ numpy/stdlib only.
 
 from __future__ import annotations
 
+import re
 from dataclasses import dataclass, field
 from pathlib import Path
 
 import numpy as np
 
-from parsers.errors import ParseError
+from parsers.errors import ParseError, ParseReport, check_mode, finite, handle, integer, read_text
 
 _NEEDED = ("EPOCH OF FIRST MAP", "EPOCH OF LAST MAP", "INTERVAL", "# OF MAPS IN FILE", "BASE RADIUS",
            "HGT1 / HGT2 / DHGT", "LAT1 / LAT2 / DLAT", "LON1 / LON2 / DLON")
@@ -41,9 +42,14 @@ class IonexMaps:
     sources: list = field(default_factory=list)
 
 
-def read_ionex(*paths) -> IonexMaps:
-    """Maps of one or more IONEX files combined in time (grids must agree)."""
-    parts = [_read_one(Path(p)) for p in paths]
+def read_ionex(*paths, errors: str = "raise", report: ParseReport | None = None) -> IonexMaps:
+    """Maps of one or more IONEX files combined in time (grids must agree).
+
+    With ``errors="report"`` a map with a fault is left out and added to ``report``; header
+    faults always raise.
+    """
+    check_mode(errors)
+    parts = [_read_one(Path(p), errors, report) for p in paths]
     head = parts[0]
     for p in parts[1:]:
         for name in ("lat_deg", "lon_deg", "height_m"):
@@ -68,36 +74,47 @@ def read_ionex(*paths) -> IonexMaps:
                      [s for p in parts for s in p.sources])
 
 
+MAX_GRID = 100_000  # points along one axis; more is not a map but a hostile header
+
+
 def _grid(v1, v2, dv, path, line, name):
     if dv == 0:
         return np.array([v1])
-    n = int(round((v2 - v1) / dv)) + 1
-    if n < 1 or not np.isclose(v1 + (n - 1) * dv, v2):
-        raise ParseError(path, f"{name} grid {v1} {v2} {dv} is not regular", line=line)
+    n = round((v2 - v1) / dv) + 1
+    if not 1 <= n <= MAX_GRID or not np.isclose(v1 + (n - 1) * dv, v2):
+        raise ParseError(path, f"{name} grid {v1} {v2} {dv} is not regular (or has more than {MAX_GRID} points)",
+                         line=line, record=name)
     return v1 + dv * np.arange(n)
 
 
 def _floats(text, n, path, line, label):
-    try:
-        vals = [float(x) for x in text.split()]
-    except ValueError:
-        raise ParseError(path, f"unreadable numbers in {label}", line=line, record=label) from None
+    vals = [finite(x, path, label, line=line, record=label) for x in text.split()]
     if len(vals) < n:
         raise ParseError(path, f"{label} needs {n} numbers", line=line, record=label)
     return vals
 
 
+_EPOCH_RANGES = ((1900, 2200), (1, 12), (1, 31), (0, 24), (0, 59), (0, 60))
+
+
 def _epoch(text, path, line, label):
-    v = _floats(text, 6, path, line, label)
-    y, mo, d, h, mi, s = (int(x) for x in v[:6])
+    fields = text.split()
+    if len(fields) < 6:
+        raise ParseError(path, f"{label} needs 6 integers (year month day hour minute second)", line=line,
+                         record=label)
+    y, mo, d, h, mi, s = (integer(x, path, label, lo, hi, line=line, record=label)
+                          for x, (lo, hi) in zip(fields, _EPOCH_RANGES))
     try:
-        return np.datetime64(f"{y:04d}-{mo:02d}-{d:02d}T{h:02d}:{mi:02d}:{s:02d}", "ns")
+        return np.datetime64(f"{y:04d}-{mo:02d}-{d:02d}", "ns") + np.timedelta64((h * 60 + mi) * 60 + s, "s")
     except ValueError:
         raise ParseError(path, f"invalid date in {label}", line=line, record=label) from None
 
 
-def _read_one(path: Path) -> IonexMaps:
-    lines = path.read_text(encoding="ascii", errors="replace").splitlines()
+_VALUE = re.compile(r" *-?\d{1,5}", re.ASCII)
+
+
+def _read_one(path: Path, errors: str, report: ParseReport | None) -> IonexMaps:
+    lines = read_text(path, "ascii").splitlines()
     head, i = {}, 0
     # ---- header
     while True:
@@ -115,39 +132,92 @@ def _read_one(path: Path) -> IonexMaps:
         if name not in head:
             raise ParseError(path, f"missing header record {name}", line=i, record=name)
     h = {k: _floats(v[0], 3 if "/" in k else 1, path, v[1], k) for k, v in head.items()
-         if k in ("INTERVAL", "# OF MAPS IN FILE", "BASE RADIUS", "HGT1 / HGT2 / DHGT", "LAT1 / LAT2 / DLAT",
-                  "LON1 / LON2 / DLON", "ELEVATION CUTOFF", "EXPONENT")}
-    heights = _grid(*h["HGT1 / HGT2 / DHGT"][:3], path, head["HGT1 / HGT2 / DHGT"][1], "HGT")
-    lats = _grid(*h["LAT1 / LAT2 / DLAT"][:3], path, head["LAT1 / LAT2 / DLAT"][1], "LAT")
-    lons = _grid(*h["LON1 / LON2 / DLON"][:3], path, head["LON1 / LON2 / DLON"][1], "LON")
+         if k in ("INTERVAL", "BASE RADIUS", "HGT1 / HGT2 / DHGT", "LAT1 / LAT2 / DLAT",
+                  "LON1 / LON2 / DLON", "ELEVATION CUTOFF")}
+    grids = [_grid(*h[k][:3], path, head[k][1], k[:3]) for k in ("HGT1 / HGT2 / DHGT", "LAT1 / LAT2 / DLAT",
+                                                                  "LON1 / LON2 / DLON")]
+    if grids[0].size * grids[1].size * grids[2].size > 10 * MAX_GRID:
+        raise ParseError(path, f"grid of {grids[0].size} x {grids[1].size} x {grids[2].size} points is too large",
+                         line=i, record="grid")
     first = _epoch(*head["EPOCH OF FIRST MAP"], path, "EPOCH OF FIRST MAP")
     _epoch(*head["EPOCH OF LAST MAP"], path, "EPOCH OF LAST MAP")
-    exponent = int(h.get("EXPONENT", [-1])[0])
-    nmaps = int(h["# OF MAPS IN FILE"][0])
+    exponent = _int_record(head, "EXPONENT", path, -1, -99, 99)
+    nmaps = _int_record(head, "# OF MAPS IN FILE", path, None, 1, 1_000_000)
     maps = {"TEC": {}, "RMS": {}, "HEIGHT": {}}
     # ---- data blocks
-    kind = None
+    while i < len(lines):
+        label = lines[i][60:].strip()
+        i += 1
+        if label == "END OF FILE":
+            break
+        if label.startswith("START OF") and label.endswith("MAP"):
+            try:
+                kind, epoch, grid, i = _map(lines, i, label, grids, exponent, path)
+            except ParseError as err:
+                handle(err, errors, report)
+                i = _skip_map(lines, max(i, (err.line or 1) - 1), label)
+                continue
+            if epoch in maps[kind]:
+                handle(ParseError(path, f"a second {kind} map at {epoch}", line=i, record=label), errors, report)
+                continue
+            maps[kind][epoch] = grid
+        elif lines[i - 1].strip() and label not in ("COMMENT",):
+            handle(ParseError(path, f"unexpected record {label or lines[i - 1].strip()[:20]!r} between maps",
+                              line=i, record=label), errors, report)
+    if not maps["TEC"]:
+        raise ParseError(path, "no TEC map", line=i)
+    epochs = np.array(sorted(maps["TEC"]), dtype="datetime64[ns]")
+    if len(epochs) != nmaps or epochs[0] != first:
+        handle(ParseError(path, f"header says {nmaps} maps from {first}, file has {len(epochs)} from {epochs[0]}",
+                          line=head["# OF MAPS IN FILE"][1], record="# OF MAPS IN FILE"), errors, report)
+    tec = np.stack([maps["TEC"][e] for e in epochs])
+    rms = np.stack([maps["RMS"][e] for e in epochs]) if set(maps["RMS"]) == set(maps["TEC"]) else None
+    hgt = np.stack([maps["HEIGHT"][e] for e in epochs]) * 1e3 if set(maps["HEIGHT"]) == set(maps["TEC"]) else None
+    mf = head.get("MAPPING FUNCTION", ("NONE", 0))[0].strip() or "NONE"
+    heights, lats, lons = grids
+    return IonexMaps(epochs, lats, lons, heights * 1e3, tec, rms, hgt, h["BASE RADIUS"][0] * 1e3, mf,
+                     h.get("ELEVATION CUTOFF", [0.0])[0], h["INTERVAL"][0], [str(path)])
+
+
+def _int_record(head, name, path, default, lo, hi):
+    if name not in head:
+        return default
+    text, line = head[name]
+    return integer((text.split() or [""])[0], path, name, lo, hi, line=line, record=name)
+
+
+def _skip_map(lines, i, label):
+    """Index of the line after the END OF ... MAP that closes a map started with ``label``."""
+    end = "END OF" + label[len("START OF"):]
+    while i < len(lines):
+        i += 1
+        if lines[i - 1][60:].strip() in (end, "END OF FILE"):
+            return i if lines[i - 1][60:].strip() == end else i - 1
+    return i
+
+
+def _map(lines, i, label, grids, exponent, path):
+    """(kind, epoch, grid, next line index) of the map whose START record is line ``i`` (1-based)."""
+    heights, lats, lons = grids
+    kind = label[9:-4].strip()
+    if kind not in ("TEC", "RMS", "HEIGHT"):
+        raise ParseError(path, f"unknown map type {label}", line=i, record=label)
+    number = integer((lines[i - 1][:60].split() or [""])[0], path, label, 1, 1_000_000, line=i, record=label)
+    epoch, grid, exp = None, np.full((heights.size, lats.size, lons.size), np.nan), exponent
+    filled = np.zeros(grid.shape, dtype=bool)
     while i < len(lines):
         raw = lines[i]
         label = raw[60:].strip()
         i += 1
-        if label.startswith("START OF") and label.endswith("MAP"):
-            kind = label[9:-4].strip()
-            if kind not in maps:
-                raise ParseError(path, f"unknown map type {label}", line=i, record=label)
-            number = int(_floats(raw[:60], 1, path, i, label)[0])
-            epoch, grid, exp = None, np.full((heights.size, lats.size, lons.size), np.nan), exponent
-        elif label == "EPOCH OF CURRENT MAP":
+        if label == "EPOCH OF CURRENT MAP":
             epoch = _epoch(raw[:60], path, i, label)
         elif label == "EXPONENT":
-            exp = int(_floats(raw[:60], 1, path, i, label)[0])
+            exp = integer((raw[:60].split() or [""])[0], path, label, -99, 99, line=i, record=number)
         elif label == "LAT/LON1/LON2/DLON/H":
-            if kind is None or epoch is None:
-                raise ParseError(path, "latitude band outside a map or before EPOCH OF CURRENT MAP", line=i)
-            try:
-                lat, l1, l2, dl, hh = (float(raw[k:k + 6]) for k in (2, 8, 14, 20, 26))
-            except ValueError:
-                raise ParseError(path, "unreadable LAT/LON1/LON2/DLON/H", line=i, record=number) from None
+            if epoch is None:
+                raise ParseError(path, "latitude band before EPOCH OF CURRENT MAP", line=i, record=number)
+            lat, l1, l2, dl, hh = (finite(raw[k:k + 6], path, "LAT/LON1/LON2/DLON/H", line=i, record=number)
+                                   for k in (2, 8, 14, 20, 26))
             row = _grid(l1, l2, dl, path, i, "LON")
             values, start = [], i
             while len(values) < row.size:
@@ -157,11 +227,10 @@ def _read_one(path: Path) -> IonexMaps:
                 text = lines[i].rstrip()
                 for k in range(0, len(text), 5):
                     field5 = text[k:k + 5]
-                    try:
-                        values.append(int(field5))
-                    except ValueError:
+                    if not _VALUE.fullmatch(field5):
                         raise ParseError(path, f"bad value {field5.strip()!r} in {kind} map {number}",
-                                         line=i + 1, record=number) from None
+                                         line=i + 1, record=number)
+                    values.append(int(field5))
                 i += 1
             try:
                 ih, ilat, ilon = _index(heights, hh), _index(lats, lat), _index(lons, row)
@@ -169,28 +238,20 @@ def _read_one(path: Path) -> IonexMaps:
                 raise ParseError(path, f"{err.args[0]} not on the header grid", line=start, record=number) from None
             v = np.asarray(values[:row.size], dtype=float)
             grid[ih, ilat, ilon] = np.where(v == 9999, np.nan, v * 10.0 ** exp)
+            filled[ih, ilat, ilon] = True
         elif label.startswith("END OF") and label.endswith("MAP"):
-            if kind is None or epoch is None:
-                raise ParseError(path, f"{label} without START OF MAP and EPOCH OF CURRENT MAP", line=i)
-            maps[kind][epoch] = grid
-            kind = None
-        elif label == "END OF FILE":
-            break
-        elif kind is not None and raw.strip() and label not in ("COMMENT",):
-            raise ParseError(path, f"unexpected record {label or raw.strip()[:20]!r} in {kind} map", line=i)
-    if kind is not None:
-        raise ParseError(path, f"file ends inside {kind} map", line=i)
-    if not maps["TEC"]:
-        raise ParseError(path, "no TEC map", line=i)
-    epochs = np.array(sorted(maps["TEC"]), dtype="datetime64[ns]")
-    if len(epochs) != nmaps or epochs[0] != first:
-        raise ParseError(path, f"header says {nmaps} maps from {first}, file has {len(epochs)} from {epochs[0]}")
-    tec = np.stack([maps["TEC"][e] for e in epochs])
-    rms = np.stack([maps["RMS"][e] for e in epochs]) if len(maps["RMS"]) == len(epochs) else None
-    hgt = np.stack([maps["HEIGHT"][e] for e in epochs]) * 1e3 if len(maps["HEIGHT"]) == len(epochs) else None
-    mf = head.get("MAPPING FUNCTION", ("NONE", 0))[0].strip() or "NONE"
-    return IonexMaps(epochs, lats, lons, heights * 1e3, tec, rms, hgt, h["BASE RADIUS"][0] * 1e3, mf,
-                     h.get("ELEVATION CUTOFF", [0.0])[0], h["INTERVAL"][0], [str(path)])
+            if label != f"END OF {kind} MAP" or epoch is None:
+                raise ParseError(path, f"{label} closes a {kind} map without EPOCH OF CURRENT MAP" if epoch is None
+                                 else f"{label} closes a {kind} map", line=i, record=number)
+            if not filled.all():
+                lat_missing = lats[~filled.all(axis=(0, 2))]
+                raise ParseError(path, f"{kind} map {number} has no values at {(~filled).sum()} grid points "
+                                 f"(latitudes {lat_missing[:4].tolist()}...)", line=i, record=number)
+            return kind, epoch, grid, i
+        elif raw.strip() and label != "COMMENT":
+            raise ParseError(path, f"unexpected record {label or raw.strip()[:20]!r} in {kind} map", line=i,
+                             record=number)
+    raise ParseError(path, f"file ends inside {kind} map {number}", line=i, record=number)
 
 
 def _index(grid, value):

@@ -3,17 +3,20 @@
 Returns one :class:`OemSegment` per META block: its metadata, epochs as
 datetime64[ns] in the file's own TIME_SYSTEM (named in ``meta``), states in
 m and m/s (the file's km, km/s converted), and covariances in m², m²/s,
-m²/s² when the segment has a covariance block.
+m²/s² when the segment has a covariance block. With ``errors="report"`` an
+unreadable ephemeris line is left out and added to the report; other faults
+(structure, covariance blocks) always raise.
 """
 
 from __future__ import annotations
 
+import re
 from dataclasses import dataclass, field
 from pathlib import Path
 
 import numpy as np
 
-from parsers.errors import ParseError
+from parsers.errors import ParseError, ParseReport, check_mode, finite, handle, read_text
 
 _TRIL = np.tril_indices(6)
 _SCALE = 1e3  # km -> m
@@ -32,10 +35,11 @@ def sniff(head: bytes) -> bool:
     return head.lstrip().startswith(b"CCSDS_OEM_VERS")
 
 
-def read(path) -> list[OemSegment]:
+def read(path, errors: str = "raise", report: ParseReport | None = None) -> list[OemSegment]:
     """Read every segment of a KVN OEM; ParseError names the file and line."""
+    check_mode(errors)
     path = Path(path)
-    lines = path.read_text().splitlines()
+    lines = read_text(path).splitlines()
     if not lines or not sniff(lines[0].encode()):
         raise ParseError(path, "not a KVN OEM (no CCSDS_OEM_VERS header)", line=1)
     segments, meta, rows, cov_rows, cov_epochs = [], None, [], [], []
@@ -46,8 +50,11 @@ def read(path) -> list[OemSegment]:
             return
         if not rows:
             raise ParseError(path, "segment without ephemeris data lines", line=lineno)
-        epochs = np.array([_epoch(path, n, r[0]) for n, r in rows], dtype="datetime64[ns]")
-        states = np.array([[_number(path, n, v) for v in r[1:7]] for n, r in rows]) * _SCALE
+        if len(cov_rows) != len(cov_epochs):
+            raise ParseError(path, f"{len(cov_epochs)} covariance EPOCHs for {len(cov_rows)} matrices", line=lineno)
+        good = [(e, x) for e, x in (_state(path, n, r, errors, report) for n, r in rows) if e is not None]
+        epochs = np.array([e for e, _ in good], dtype="datetime64[ns]")
+        states = np.array([x for _, x in good]).reshape(-1, 6) * _SCALE
         covs = np.zeros((len(cov_rows), 6, 6))
         for k, (n, vals) in enumerate(cov_rows):
             covs[k][_TRIL] = vals
@@ -100,15 +107,28 @@ def read(path) -> list[OemSegment]:
     return segments
 
 
+def _state(path, lineno, fields, errors, report):
+    """(epoch, 6 numbers km, km/s) of an ephemeris line, or (None, None) when reported."""
+    try:
+        return _epoch(path, lineno, fields[0]), [_number(path, lineno, v) for v in fields[1:7]]
+    except ParseError as err:
+        handle(err, errors, report)
+        return None, None
+
+
+_EPOCH = re.compile(r"\d{4}-(\d{2}-\d{2}|\d{3})T\d{2}:\d{2}:\d{2}(\.\d{1,9})?Z?", re.ASCII)
+
+
 def _epoch(path, lineno, text):
+    if not _EPOCH.fullmatch(text):
+        raise ParseError(path, f"bad epoch {text[:40]!r} (want YYYY-MM-DDThh:mm:ss[.f])", line=lineno)
+    if not 1678 <= int(text[:4]) <= 2261:  # datetime64[ns] would wrap round silently
+        raise ParseError(path, f"epoch {text[:40]!r} is outside 1678-2261", line=lineno)
     try:
         return np.datetime64(text.rstrip("Z"), "ns")
     except ValueError:
-        raise ParseError(path, f"bad epoch {text!r}", line=lineno) from None
+        raise ParseError(path, f"bad epoch {text[:40]!r}", line=lineno) from None
 
 
 def _number(path, lineno, text):
-    try:
-        return float(text)
-    except ValueError:
-        raise ParseError(path, f"bad number {text!r}", line=lineno) from None
+    return finite(text, path, "number", line=lineno)

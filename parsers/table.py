@@ -65,6 +65,21 @@ STAGE_COLUMNS: dict[str, str] = {
 """Sign convention: every ``doppler_*`` value is positive when the spacecraft
 recedes (Moyer, DSN), whatever the source format's own sign."""
 
+# Edit-reason bits of ``flags`` that readers set themselves (odpipe.preprocess.flags.Flag takes them from here).
+DUPLICATE = 1 << 1  # the row repeats an earlier row's sample: every SAMPLE column equal, the first is kept
+INVALID = 1 << 2    # the format marks the record invalid, or the value is not finite (NaN, inf): set by build
+SAMPLE = ["epoch", "tag", "observable", "unit", "count_time", "station_tx", "station_rx", "spacecraft", "band_up",
+          "band_down"]
+
+
+def flag_duplicates(df: pd.DataFrame) -> pd.DataFrame:
+    """``df`` with DUPLICATE set on every row whose SAMPLE columns equal an earlier row's (in place)."""
+    if len(df):
+        dup = df.duplicated(subset=SAMPLE, keep="first").to_numpy()
+        if dup.any():
+            df["flags"] = df["flags"].to_numpy(np.int64) | np.where(dup, DUPLICATE, 0)
+    return df
+
 
 def empty(extra: dict[str, str] | None = None) -> pd.DataFrame:
     """An empty TrackingTable with the contract's dtypes (plus ``extra`` columns)."""
@@ -75,6 +90,8 @@ def empty(extra: dict[str, str] | None = None) -> pd.DataFrame:
 
 def build(n: int, **columns) -> pd.DataFrame:
     """A TrackingTable of ``n`` rows from arrays/scalars; unset columns get missing values.
+
+    Rows whose ``value`` is not finite (NaN, inf) get the INVALID bit in ``flags``: kept, never silent.
 
     Format-specific extra columns may be passed too; they are kept after the
     contract's columns. A str column may be given as a ``pd.Categorical`` (see
@@ -102,6 +119,9 @@ def _build(n: int, columns: dict, owned: bool) -> pd.DataFrame:
             for name, (dt, _) in COLUMNS.items()}
     for name, val in columns.items():
         data[name] = np.broadcast_to(np.asarray(val), (n,)).copy() if np.ndim(val) == 0 else np.asarray(val)
+    bad = ~np.isfinite(data["value"])
+    if bad.any():
+        data["flags"] = data["flags"] | np.where(bad, INVALID, 0)
     seen: set[int] = set()
     for name, arr in data.items():
         if isinstance(arr, np.ndarray):

@@ -37,7 +37,7 @@ from pathlib import Path
 
 import numpy as np
 
-from parsers.errors import ParseError, ParseReport, handle
+from parsers.errors import ParseError, ParseReport, finite, handle, integer, read_text
 
 MODELS = ("DRY NUPART", "WET NUPART", "CHPART")
 SERIES = ("NRMPOW", "CONST", "TRIG")
@@ -126,10 +126,7 @@ def _parse_card(text: str, fitsig: float, path, line: int) -> Card:
     model = " ".join(m["model"].split()).upper()
     if model not in MODELS:
         raise ParseError(path, f"unknown model MODEL({model})", line=line)
-    try:
-        coefs = tuple(float(c) for c in m["coefs"].split(",") if c.strip())
-    except ValueError:
-        raise ParseError(path, f"bad coefficient list ({m['coefs'].strip()})", line=line) from None
+    coefs = tuple(finite(c, path, "coefficient", line=line) for c in m["coefs"].split(",") if c.strip())
     need = {"NRMPOW": 1, "CONST": 1, "TRIG": 2}[series]
     if len(coefs) < need or (series == "CONST" and len(coefs) != 1) or (series == "TRIG" and len(coefs) % 2):
         raise ParseError(path, f"{series} with {len(coefs)} coefficients", line=line)
@@ -152,10 +149,7 @@ def _parse_card(text: str, fitsig: float, path, line: int) -> Card:
     network = scope.get("DSN", "").replace(" ", "").upper()
     if not network:
         raise ParseError(path, "card has no DSN(...) complex or station scope", line=line)
-    try:
-        scid = int(scope["SCID"]) if "SCID" in scope else -1
-    except ValueError:
-        raise ParseError(path, f"bad SCID({scope['SCID']})", line=line) from None
+    scid = integer(scope["SCID"], path, "SCID", 0, 1023, line=line) if "SCID" in scope else -1
     return Card(model, series, coefs, start, end, network, DATA_TYPES[types], scid, fitsig,
                 Path(str(path)).name, line)
 
@@ -163,12 +157,17 @@ def _parse_card(text: str, fitsig: float, path, line: int) -> Card:
 def parse_text(text: str, path="<text>", errors: str = "raise", report: ParseReport | None = None) -> list[Card]:
     """Cards of a TRK-2-23 text; a card that cannot be read raises (or is reported)."""
     cards, buf, first, fitsig = [], "", 0, np.nan
+    reported = len(report) if report is not None else 0
     for n, raw in enumerate(text.splitlines(), 1):
         s = raw.strip()
         if s.startswith("#"):
-            m = re.match(r"#\s*FITSIG\s*=\s*([-+.\dEe]+)", s)
+            m = re.match(r"#\s*FITSIG\s*=\s*(\S*)", s)
             if m and not buf:
-                fitsig = float(m.group(1))
+                try:
+                    fitsig = finite(m.group(1), path, "FITSIG", line=n, record=len(cards))
+                except ParseError as err:
+                    handle(err, errors, report)
+                    fitsig = np.nan
             continue
         s = s.split("#", 1)[0].strip()
         if not s:
@@ -185,6 +184,8 @@ def parse_text(text: str, path="<text>", errors: str = "raise", report: ParseRep
             buf, fitsig = "", np.nan
     if buf:
         handle(ParseError(path, "card not terminated by ').'", line=first, record=len(cards)), errors, report)
+    if not cards and (report is None or len(report) == reported):
+        raise ParseError(path, "no ADJUST cards")
     return cards
 
 
@@ -192,7 +193,7 @@ def read_trk223(*paths, errors: str = "raise", report: ParseReport | None = None
     """A CalibrationSet of the cards of one or more TRK-2-23 files (in the order given)."""
     cards = []
     for p in paths:
-        cards += parse_text(Path(p).read_text(encoding="ascii", errors="replace"), p, errors, report)
+        cards += parse_text(read_text(p, "ascii"), p, errors, report)
     return CalibrationSet(cards)
 
 

@@ -30,20 +30,23 @@ of one vehicle and pad (or count / interval for destruct Doppler; NaN for the
 first of a series), angles in rad. Extra columns: ``valid`` (the row's
 validity bit), ``validity`` (the byte), ``vid``, ``tracker_type``,
 ``band_code``, ``data_interval_s``, ``doppler_count``, ``factor_m`` and
-``doppler_shift_hz`` (the format's own signed shift, positive approaching). ``meta["records"]`` holds every field of every
+``doppler_shift_hz`` (the format's own signed shift, positive approaching). The rows of a
+record with the same SIC, VID, pads and time tag as an earlier one are kept with the DUPLICATE flag,
+a row without a finite value with the INVALID flag (:mod:`parsers.table`); an empty
+file is a ParseError in both modes. ``meta["records"]`` holds every field of every
 record (AGC, mode, antenna types, router, TDRSS-only bytes, ...; join on
 ``record``) and :func:`write` turns such a frame back into bytes, bit for bit.
 """
 
 from __future__ import annotations
 
-import os
 from pathlib import Path
 
 import numpy as np
 import pandas as pd
 
 from parsers import table as tt
+from parsers.atomic import write_bytes
 from parsers.errors import ParseError, ParseReport, check_mode, handle
 from parsers.table import TrackingData
 
@@ -89,6 +92,8 @@ def read(path, errors: str = "raise") -> TrackingData:
     buf = path.read_bytes()
     report = ParseReport()
     n = len(buf) // RECORD
+    if n == 0:
+        raise ParseError(path, f"no UTDF record: {len(buf)} bytes, a record is {RECORD}", offset=0)
     if len(buf) % RECORD:
         handle(ParseError(path, f"trailing partial record of {len(buf) % RECORD} bytes",
                           offset=n * RECORD, record=n), errors, report)
@@ -160,11 +165,8 @@ def _fit(name: str, col: np.ndarray, bits: int) -> np.ndarray:
 
 
 def write(path, records: pd.DataFrame) -> None:
-    """Write records (RECORD_FIELDS) to ``path`` atomically (temporary file, then rename)."""
-    path = Path(path)
-    tmp = path.with_name(path.name + ".tmp")
-    tmp.write_bytes(encode(records))
-    os.replace(tmp, path)
+    """Write records (RECORD_FIELDS) to ``path`` atomically (:mod:`parsers.atomic`)."""
+    write_bytes(path, encode(records))
 
 
 def epochs(rec: pd.DataFrame) -> np.ndarray:
@@ -223,6 +225,8 @@ def _table(rec: pd.DataFrame, source: str) -> pd.DataFrame:
     flat = flat[np.argsort(epoch[flat // len(KINDS)], kind="stable")]  # time order, file order among equals
     r, k = flat // len(KINDS), flat % len(KINDS)
     is_doppler = k == 1
+    repeated = rec.duplicated(subset=["sic", "vid", "tx_pad", "rx_pad", "year", "seconds_of_year",
+                                      "microseconds"]).to_numpy()  # a second record of the same sample
     sics, sic_code = np.unique(col["sic"], return_inverse=True)
     return tt.build_owned(
         len(r), epoch=epoch[r], tag=tt.coded(k, TAGS), observable=tt.coded(names.ravel()[flat], OBSERVABLES),
@@ -232,7 +236,7 @@ def _table(rec: pd.DataFrame, source: str) -> pd.DataFrame:
         band_up=tt.coded(np.where(two_way[r], band[r], 16), BAND_UP), band_down=tt.coded(band[r], BAND_DOWN),
         uplink_hz=np.where(two_way[r], tx_hz[r], np.nan),
         transponder_ratio=np.where(two_way[r], factor_k[r], np.nan),
-        source=source, record=rec.index.to_numpy()[r].astype(np.int64), flags=0,
+        source=source, record=rec.index.to_numpy()[r].astype(np.int64), flags=np.where(repeated[r], tt.DUPLICATE, 0),
         valid=bits.ravel()[flat], validity=valid[r], vid=col["vid"][r], tracker_type=tracker[r] >> 12,
         band_code=band[r], data_interval_s=interval[r], doppler_count=np.where(is_doppler, cnt[r], -1),
         factor_m=np.where(is_doppler, factor_m[r], np.nan),

@@ -31,6 +31,7 @@ import pandas as pd  # noqa: E402
 from odpipe.analysis.overlap import compare, oem_trajectory  # noqa: E402
 from odpipe.pipeline.run import run_config  # noqa: E402
 from odpipe.products import residuals  # noqa: E402
+from odpipe.products.atomic import save_figure, write_csv, write_text  # noqa: E402
 from odpipe.time import utc_to_tdb  # noqa: E402
 
 HERE = Path(__file__).resolve().parent
@@ -50,7 +51,7 @@ def derived_config(arc: str, degree: int, out: Path) -> Path:
         (out / f"{m.group(1)}_deg{degree}" if m.group(1) in ARCS else HERE / "out" / m.group(1))
         / "current" / "trajectory.oem"), text, flags=re.M)
     path = out / f"{arc}_deg{degree}.toml"
-    path.write_text(text)
+    write_text(path, text)
     return path
 
 
@@ -96,10 +97,10 @@ def main(argv=None) -> int:
         stats = compare(_window(a, lo, hi), _window(b, lo, hi), f"deg{degree}", step=60.0).statistics()
         overlaps.append({"degree": degree, **stats})
     table, ov = pd.DataFrame(rows), pd.DataFrame(overlaps)
-    table.to_csv(out / "degree_study.csv", index=False)
-    ov.to_csv(out / "degree_study_overlaps.csv", index=False)
-    pd.concat(passes, ignore_index=True).to_csv(out / "passes.csv", index=False)
-    (out / "degree_study.md").write_text(_markdown(table, ov))
+    write_csv(out / "degree_study.csv", table, index=False)
+    write_csv(out / "degree_study_overlaps.csv", ov, index=False)
+    write_csv(out / "passes.csv", pd.concat(passes, ignore_index=True), index=False)
+    write_text(out / "degree_study.md", _markdown(table, ov))
     _plot(table, ov, out / "degree_study.png")
     print(f"report: {out / 'degree_study.md'}")
     return 0
@@ -142,7 +143,7 @@ def _plot(table: pd.DataFrame, ov: pd.DataFrame, path: Path) -> None:
     for ax in (ax1, ax2):
         ax.grid(alpha=0.3)
     fig.tight_layout()
-    fig.savefig(path, dpi=110)
+    save_figure(path, fig, dpi=110)
     plt.close(fig)
 
 

@@ -25,6 +25,7 @@ import pandas as pd
 
 from odpipe.liaison import turan
 from odpipe.liaison.orbits import keplerian_orbit
+from odpipe.products.atomic import write_csv
 
 HERE = Path(__file__).resolve().parent
 CFG = tomllib.loads((HERE / "liaison_turan.toml").read_text())
@@ -62,7 +63,7 @@ def main():
     with ProcessPoolExecutor(2) as pool:
         df = pd.DataFrame(list(pool.map(evaluate, orbiters, chunksize=4)))
     args.out.mkdir(parents=True, exist_ok=True)
-    df.to_csv(args.out / "lunar_search.csv", index=False)
+    write_csv(args.out / "lunar_search.csv", df, index=False)
     df["start"] = np.where(np.cos(np.radians(df["true_anomaly_deg"])) > np.cos(np.radians(30)),
                            "within 30 deg of periselene", "elsewhere")
     pd.set_option("display.width", 160)

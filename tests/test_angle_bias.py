@@ -103,6 +103,10 @@ def test_run_config_takes_angle_sigmas_with_units(tmp_path):
     from odpipe.runs.schema import ConfigError
     from tests.heo_case import write_config
 
+    from odpipe.preprocess import store
+
+    store.write(tmp_path / "tracking.parquet", build(1, epoch=np.datetime64("2003-06-01T01:00", "ns"),
+                                                     observable="angle_az", unit="rad", value=0.0))
     write_config(tmp_path, "angles", "2003-06-01T00:05:00", "2003-06-01T02:00:00", np.r_[R0, V0])
     text = (tmp_path / "arc.toml").read_text()
     good = 'data_sigma = { range = 1.0, angle_az = "0.01 deg", angle_el = 1.7e-4 }'
@@ -110,5 +114,5 @@ def test_run_config_takes_angle_sigmas_with_units(tmp_path):
     assert load_config(tmp_path / "arc.toml").estimation.data_sigma["angle_az"] == "0.01 deg"
     (tmp_path / "arc.toml").write_text(text.replace("data_sigma = { range = 1.0, doppler_2way = 1e-4 }",
                                                     'data_sigma = { range = "1 m" }'))
-    with pytest.raises(ConfigError, match=r"estimation\.data_sigma\.range.*only angle observables take a unit"):
+    with pytest.raises(ConfigError, match=r"estimation\.data_sigma\.range\].*only angle observables take a unit"):
         load_config(tmp_path / "arc.toml")

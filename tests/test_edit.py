@@ -79,6 +79,23 @@ def test_duplicates_invalid_elevation_short_pass_arc_and_windows():
     assert names(out["flags"].iloc[601]) == ["short_pass", "outside_arc"]
 
 
+def test_rows_the_elevation_mask_cannot_judge_are_logged(caplog):
+    """No elevation_rx column, or NaN in it: the used rows the mask could not judge are counted in a warning."""
+    tab = sine_doppler(n=600)
+    with caplog.at_level("WARNING", logger="odpipe.preprocess.edit"):
+        edit(tab)
+    assert [r.getMessage() for r in caplog.records] == [
+        "no elevation_rx column: the elevation mask was not applied to 600 used rows"]
+    caplog.clear()
+    tab["elevation_rx"] = np.radians(30.0)
+    tab.loc[:99, "elevation_rx"] = np.nan                             # e.g. outside the trajectory
+    with caplog.at_level("WARNING", logger="odpipe.preprocess.edit"):
+        out, _ = edit(tab, config=EditConfig(arc=(T0 + np.timedelta64(50, "s"), T0 + np.timedelta64(600, "s"))))
+    assert bits(out, Flag.OUTSIDE_ARC).sum() == 50                    # flagged anyway: not counted
+    assert [r.getMessage() for r in caplog.records] == [
+        "50 used rows have no elevation_rx (NaN): not checked against the elevation mask"]
+
+
 def test_range_outside_its_modulus_is_flagged():
     tab = build(4, epoch=T0 + np.arange(4) * np.timedelta64(600, "s"), tag="receive", observable="range",
                 value=[10.0, 2.0 ** 25, -1.0, 3.3e7], unit="RU", count_time=0.0, station_rx="DSS-25",

@@ -81,3 +81,45 @@ def test_rms_maps_read_beside_tec(tmp_path, shared_data):
     m = read_ionex(p)
     assert m.rms is not None and m.rms.shape == m.tec.shape
     np.testing.assert_array_equal(m.rms, m.tec)
+
+
+def _jammed(shared_data):
+    return (shared_data / "ionex" / "jammed-fields.14i").read_text().splitlines()
+
+
+def _write(tmp_path, lines):
+    p = tmp_path / "x.14i"
+    p.write_text("\n".join(lines) + "\n")
+    return p
+
+
+def _replace(lines, label, data):
+    return [data.ljust(60) + ln[60:] if ln[60:].strip() == label else ln for ln in lines]
+
+
+@pytest.mark.parametrize("label, data, words", [
+    ("LAT1 / LAT2 / DLAT", "    25.0  20.0   nan", "finite"),
+    ("LON1 / LON2 / DLON", "  -180.0 180.0  1e-9", "not regular"),
+    ("EPOCH OF FIRST MAP", "  1e400     2    13     2     0     0", "integer"),
+    ("EPOCH OF FIRST MAP", "     0     2    13     2     0     0", "outside"),
+    ("# OF MAPS IN FILE", "9" * 59, "integer"),
+])
+def test_absurd_header_numbers_are_parse_errors(tmp_path, shared_data, label, data, words):
+    with pytest.raises(ParseError, match=words) as info:
+        read_ionex(_write(tmp_path, _replace(_jammed(shared_data), label, data)))
+    assert info.value.line is not None
+
+
+def test_map_with_a_missing_latitude_band_is_refused_or_reported(tmp_path, shared_data):
+    from parsers.errors import ParseReport
+    lines = _jammed(shared_data)
+    band, end = [i for i, ln in enumerate(lines) if ln[60:].strip() == "LAT/LON1/LON2/DLON/H"][:2]
+    holey = lines[:band] + lines[end:]  # first map loses its first latitude band: a hole of NaN
+    with pytest.raises(ParseError, match="no values at"):
+        read_ionex(_write(tmp_path, holey))
+    report = ParseReport()
+    maps = read_ionex(_write(tmp_path, holey), errors="report", report=report)
+    whole = read_ionex(shared_data / "ionex" / "jammed-fields.14i")
+    # the holey map is left out and reported (and the header's map count with it); the other map is kept
+    assert len(maps.epochs) == len(whole.epochs) - 1 and len(report) == 2
+    np.testing.assert_array_equal(maps.tec[0], whole.tec[1])

@@ -79,3 +79,84 @@ def test_plan_errors_name_the_line(tmp_path):
                  'duration = 10.0\nthrust = 1.0\ndirection = [1.0, 1.0, 0.0]\n')
     with pytest.raises(ParseError, match="unit vector"):
         read_plan(t)
+
+
+_CSV_HEAD = "name,epoch,kind,frame,dv1,dv2,dv3\n"
+_GOOD_ROW = "A,2012-01-01T00:00:00,impulsive,RTN,1,2,3\n"
+
+
+@pytest.mark.parametrize("row, words", [
+    ("B,0000-01-01T00:00:00,impulsive,RTN,1,2,3", "epoch"),        # year 0
+    ("B,,impulsive,RTN,1,2,3", "missing epoch"),                    # a maneuver with no epoch
+    ("B,now,impulsive,RTN,1,2,3", "ISO 8601"),
+    ("B,2012-01-01T00:00:00,impulsive,RTN,1e400,2,3", "finite"),
+    ("B,2012-01-01T00:00:00,impulsive,RTN,nan,2,3", "finite"),
+    ("B,2012-01-01T00:00:00,impulsive,RTN," + "9" * 5000 + ",2,3", "number"),
+    ("B,2012-01-01T00:00:00,impulsive,RTN,1," + "x" * 200_000 + ",3", "CSV"),  # over the csv field limit
+    ("B,2012-01-01T00:00:00,impulsive,RTN,1,2", "fields"),
+])
+def test_bad_csv_plan_rows_are_parse_errors_and_reported(tmp_path, row, words):
+    p = tmp_path / "plan.csv"
+    p.write_text(_CSV_HEAD + _GOOD_ROW + row + "\n" + _GOOD_ROW.replace("A,", "C,"))
+    with pytest.raises(ParseError, match=words) as err:
+        read_plan(p)
+    assert err.value.line == 3
+    report = ParseReport()
+    assert read_plan(p, errors="report", report=report)["name"].tolist() == ["A", "C"]
+    assert [e.line for e in report] == [3]
+
+
+@pytest.mark.parametrize("body, words", [
+    ('epoch = 0000-01-01T00:00:00Z', "TOML"),            # year 0: tomllib's own ValueError
+    ('epoch = 2012-01-01T00:00:00Z\ndv = ' + "9" * 5000, "TOML"),  # 5000-digit integer
+    ('epoch = 2012-01-01T00:00:00Z\ndv = 5', "dv"),      # not a 3-vector
+    ('dv = [1.0, 2.0, 3.0]', "missing epoch"),           # a plan with no epoch
+    ('epoch = 2012-01-01T00:00:00Z\ndv = [1.0, true, 3.0]', "number"),
+    ('epoch = 12:00:00\ndv = [1.0, 2.0, 3.0]', "epoch"),
+])
+def test_bad_toml_plans_are_parse_errors(tmp_path, body, words):
+    p = tmp_path / "plan.toml"
+    p.write_text(f'[[maneuver]]\nname = "X"\nkind = "impulsive"\nframe = "RTN"\n{body}\n')
+    with pytest.raises(ParseError, match=words):
+        read_plan(p)
+
+
+@pytest.mark.parametrize("blob", [b"", b"\n \n", b"name,epoch\xff,kind,frame\n"])
+def test_empty_or_not_utf8_plan_is_a_parse_error_in_both_modes(tmp_path, blob):
+    p = tmp_path / "plan.csv"
+    p.write_bytes(blob)
+    for mode in ("raise", "report"):
+        with pytest.raises(ParseError) as err:
+            read_plan(p, errors=mode, report=ParseReport())
+    assert err.value.offset == blob.find(b"\xff") if b"\xff" in blob else err.value.reason == "empty file"
+
+
+@pytest.mark.realdata
+def test_grail_log_bad_byte_and_bad_lines(shared_data, tmp_path):
+    text = (shared_data / MAS).read_bytes()
+    lines = text.split(b"\n")
+    p = tmp_path / "mas.asc"
+    p.write_bytes(b"\n".join(lines[:10]) + b"\n\xad\n")
+    with pytest.raises(ParseError, match="utf-8") as err:
+        read_mas(p)
+    assert err.value.offset == len(b"\n".join(lines[:10])) + 1 and err.value.line == 11
+    # a mass of 1e400, a day 0 and a field of 200,000 characters: three lines reported, the others kept
+    bad = [lines[5].replace(b"306.16464", b"1e400"), lines[6].replace(b"11-256", b"11-000"),
+           lines[7] + b"   " + b"9" * 200_000]
+    p.write_bytes(b"\n".join(lines[:5] + bad + lines[8:]))
+    report = ParseReport()
+    log = read_mas(p, errors="report", report=report)
+    assert len(log) == 174 - 3 and [e.line for e in report] == [6, 7, 8]
+    with pytest.raises(ParseError):
+        read_mas(p)
+
+
+def test_bad_toml_row_names_its_table_line(tmp_path):
+    p = tmp_path / "plan.toml"
+    write_plan(plan(), p)
+    text = p.read_text().replace("kind = \"finite\"", "kind = \"finit\"")
+    p.write_text(text)
+    with pytest.raises(ParseError, match="kind") as err:
+        read_plan(p)
+    assert text.splitlines()[err.value.line - 1] == "[[maneuver]]" and err.value.record == 1
+    assert err.value.line == [n for n, ln in enumerate(text.splitlines(), 1) if ln == "[[maneuver]]"][1]

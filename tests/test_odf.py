@@ -14,10 +14,7 @@ from decimal import Decimal
 import numpy as np
 import pandas as pd
 import pytest
-from hypothesis import HealthCheck, given, settings
-from hypothesis import strategies as st
 
-from tests.fuzzing import mutated
 from parsers import ParseError, odf
 
 MESSENGER = "messenger/odf07155.odf"
@@ -225,28 +222,6 @@ def test_not_an_odf_raises_parse_error(tmp_path):
 def test_sniff(shared_data):
     assert odf.sniff(_messenger_bytes(shared_data)[:64])
     assert not odf.sniff((shared_data / "utdf" / "data.utd").read_bytes())
-
-
-@pytest.fixture(scope="module")
-def odf_head(shared_data):
-    """The first 400 records of the MESSENGER file with a proper EOF group and ramps."""
-    buf = _messenger_bytes(shared_data)
-    return buf[: 36 * 300] + buf[36 * 2233: 36 * 2240] + buf[36 * 2405: 36 * 2407]
-
-
-@pytest.mark.realdata
-@settings(max_examples=150, deadline=None, suppress_health_check=[HealthCheck.function_scoped_fixture])
-@given(data=st.data())
-def test_fuzz_only_parse_errors(odf_head, tmp_path_factory, data):
-    buf = mutated(data, odf_head)
-    p = tmp_path_factory.mktemp("fuzz") / "f.odf"
-    p.write_bytes(bytes(buf))
-    for mode in ("raise", "report"):
-        try:
-            d = odf.read(p, errors=mode)
-        except ParseError:
-            continue
-        assert len(d.table) <= len(buf) // 36
 
 
 @pytest.mark.realdata

@@ -1,4 +1,5 @@
-"""Residual statistics per station and per pass, in line-of-sight units and in the observable's unit."""
+"""Residual statistics per station and per pass, in line-of-sight units and in the observable's unit;
+the editing table that adds up with them."""
 
 from __future__ import annotations
 
@@ -6,22 +7,61 @@ import numpy as np
 import pandas as pd
 import pytest
 
-from odpipe.products.residuals import statistics
+from odpipe.preprocess.flags import Flag, summary
+from odpipe.products.residuals import edit_summary, report_tables, statistics
 
 
-def test_rms_per_station_and_pass_in_both_units():
+@pytest.fixture
+def res():
     rng = np.random.default_rng(3)
     n = 400
     hz_per_mps = 15.2  # S-band two-way: 1 mm/s = 15.2 mHz
     los = np.where(np.arange(n) < 200, 1e-3, 3e-3) * rng.standard_normal(n)
-    res = pd.DataFrame({"station_rx": "DSS-24", "observable": "doppler_2way", "pass_id": np.arange(n) // 200,
-                        "postfit_los": los, "prefit_los": 2 * los, "postfit": los * hz_per_mps,
+    out = pd.DataFrame({"station_rx": "DSS-24", "observable": "doppler_2way", "pass_id": np.arange(n) // 200,
+                        "epoch": np.datetime64("2012-04-09T04:00", "ns") + np.arange(n) * np.timedelta64(60, "s"),
+                        "unit": "Hz", "postfit_los": los, "apriori_los": 2 * los, "postfit": los * hz_per_mps,
                         "flags": 0, "status": ""})
-    res.loc[5, "flags"] = 8  # an edited row is counted, not used
+    out.loc[5, "flags"] = int(Flag.RESIDUAL)  # an edited row is counted, not used
+    out.loc[7, "status"] = "no light-time solution"  # a row the models could not compute
+    return out, los, hz_per_mps
+
+
+def test_rms_per_station_and_pass_in_both_units(res):
+    res, los, hz_per_mps = res
     per_pass = statistics(res, by=("station_rx", "pass_id"))
-    want = [np.sqrt(np.mean(np.delete(los[:200], 5) ** 2)), np.sqrt(np.mean(los[200:] ** 2))]
+    want = [np.sqrt(np.mean(np.delete(los[:200], [5, 7]) ** 2)), np.sqrt(np.mean(los[200:] ** 2))]
     assert per_pass["postfit_rms"].tolist() == pytest.approx(want, rel=1e-12)
-    assert per_pass["postfit_rms_unit"].tolist() == pytest.approx(np.array(want) * hz_per_mps, rel=1e-12)
-    assert per_pass["n_used"].tolist() == [199, 200] and per_pass["n_edited"].tolist() == [1, 0]
+    assert per_pass["prefit_rms"].tolist() == pytest.approx(2 * np.array(want), rel=1e-12)  # the a priori's
+    assert per_pass["postfit_rms_obs"].tolist() == pytest.approx(np.array(want) * hz_per_mps, rel=1e-12)
+    assert per_pass["obs_unit"].tolist() == ["Hz", "Hz"]
+    assert per_pass["n_used"].tolist() == [198, 200] and per_pass["n_edited"].tolist() == [1, 0]
+    assert per_pass["n_failed"].tolist() == [1, 0]
+    assert per_pass["start"].iloc[1] == np.datetime64("2012-04-09T07:20", "ns")  # row 200
     whole = statistics(res)
-    assert whole["postfit_rms"].iloc[0] == pytest.approx(np.sqrt(np.mean(np.delete(los, 5) ** 2)), rel=1e-12)
+    assert whole["postfit_rms"].iloc[0] == pytest.approx(np.sqrt(np.mean(np.delete(los, [5, 7]) ** 2)), rel=1e-12)
+    assert whole["los_unit"].tolist() == ["m/s"]
+
+
+def test_report_tables_show_mm_per_s_and_the_observed_unit(res):
+    res, los, hz_per_mps = res
+    (caption, table, formats), = report_tables(statistics(res, by=("station_rx", "observable", "pass_id")))
+    assert caption == "doppler_2way (observed in Hz)"
+    assert list(table.columns) == ["station_rx", "pass_id", "n_used", "n_edited", "n_failed", "start (UTC)",
+                                   "end (UTC)", "pre-fit RMS (mm/s)", "post-fit mean (mm/s)", "post-fit RMS (mm/s)",
+                                   "post-fit RMS (Hz)"]
+    assert table["post-fit RMS (mm/s)"].iloc[1] == pytest.approx(np.sqrt(np.mean(los[200:] ** 2)) * 1e3, rel=1e-12)
+
+
+def test_edit_summary_adds_up_with_the_residual_tables(res):
+    res, _, _ = res
+    flags = np.zeros(450, int)
+    flags[:30] = int(Flag.ELEVATION)
+    flags[30:40] = int(Flag.BLUNDER)  # 410 rows handed to the fit, 400 of them in its residual table
+    table = edit_summary(summary(flags), res)
+    rows = dict(zip(table["reason"], table["rows"]))
+    assert rows == {"elevation": 30, "blunder": 10, "passed to the fit": 410,
+                    "outside the arc or no data sigma": 10, "not computable: no light-time solution": 1,
+                    "edited (innovation test)": 1, "fitted": 398}
+    stats = statistics(res)
+    assert rows["fitted"] == stats["n_used"].sum() and rows["edited (innovation test)"] == stats["n_edited"].sum()
+    assert rows["passed to the fit"] == table.loc[table["stage"] == "fit", "rows"].sum()

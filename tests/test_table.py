@@ -35,3 +35,14 @@ def test_readers_refuse_an_unknown_errors_mode_before_reading(tmp_path):
     for reader in (odf, utdf):
         with pytest.raises(ValueError, match="errors must be 'raise' or 'report'"):
             reader.read(missing, errors="skip")
+
+
+def test_non_finite_values_are_flagged_invalid_and_repeated_samples_duplicate():
+    from parsers import table as tt
+    t = tt.build(4, epoch=np.array(["2020-01-01T00:00:00"] * 2 + ["2020-01-01T00:00:01"] * 2, "datetime64[ns]"),
+                 observable="range", value=np.array([1.0, np.nan, np.inf, 1.0]), flags=np.array([0, 0, 32, 0]))
+    assert t["flags"].tolist() == [0, tt.INVALID, tt.INVALID | 32, 0]
+    tt.flag_duplicates(t)
+    assert t["flags"].tolist() == [0, tt.INVALID | tt.DUPLICATE, tt.INVALID | 32, tt.DUPLICATE]
+    from odpipe.preprocess.flags import Flag
+    assert (Flag.INVALID, Flag.DUPLICATE) == (tt.INVALID, tt.DUPLICATE)

@@ -212,3 +212,50 @@ def test_leap_second_scales_match_published_offsets():
     assert tdm.times.to_utc(tt_, "TT")[0] == np.datetime64("2013-01-01T00:00:00", "ns")
     utc = np.array(["2016-12-31T23:59:59", "2017-01-01T00:00:00"], dtype="datetime64[ns]")
     assert list(tdm.times.to_utc(tdm.times.from_utc(utc, "TAI"), "TAI")) == list(utc)
+
+
+def test_inf_and_nan_values_are_flagged_rows_and_a_line_without_value_is_reported(kvn, tmp_path):
+    from parsers import table as tt
+    lines = kvn("TDMExample2.txt").read_text().splitlines()
+    rx = [i for i, ln in enumerate(lines) if ln.strip().startswith("RECEIVE_FREQ_1")]
+    lines[rx[0]] = lines[rx[0]].rsplit(None, 1)[0] + " inf"
+    lines[rx[1]] = lines[rx[1]].rsplit(None, 1)[0] + " 1e400"
+    lines[rx[2]] = lines[rx[2]].rsplit(None, 1)[0] + " NaN"
+    lines[rx[3]] = lines[rx[3]].rsplit(None, 1)[0]  # the value is missing
+    p = tmp_path / "x.tdm"
+    p.write_text("\n".join(lines) + "\n")
+    with pytest.raises(ParseError) as err:
+        tdm.read(p)
+    assert err.value.line == rx[3] + 1
+    d = tdm.read(p, errors="report")
+    assert [e.line for e in d.report] == [rx[3] + 1]
+    t = d.table.set_index("line")
+    assert len(t) == 7 - 1
+    flagged = t["flags"] & tt.INVALID != 0
+    assert sorted(t.index[flagged]) == [rx[0] + 1, rx[1] + 1, rx[2] + 1]  # kept, flagged, never silent
+    assert (t.loc[~flagged, "value"].abs() < 1e12).all()
+
+
+@pytest.mark.parametrize("blob", [b"", b"   \n", b"CCSDS_TDM_VERS = 2.0\nCOMMENT \xff\n"])
+def test_empty_or_not_utf8_kvn_is_a_parse_error(tmp_path, blob):
+    p = tmp_path / "x.tdm"
+    p.write_bytes(blob)
+    for mode in ("raise", "report"):
+        with pytest.raises(ParseError):
+            tdm.read(p, errors=mode)
+
+
+def test_non_finite_metadata_number_is_a_parse_error(kvn, tmp_path):
+    text = kvn("TDMExample2.txt").read_text()
+    p = tmp_path / "x.tdm"
+    p.write_text(text.replace("TRANSMIT_DELAY_1 = 0.000077", "TRANSMIT_DELAY_1 = 1e400"))
+    with pytest.raises(ParseError, match="TRANSMIT_DELAY_1"):
+        tdm.read(p, errors="report")
+
+
+@pytest.mark.parametrize("name, line, rows", [("kvn/TDM-data-wrong-keyword.txt", 26, 6),
+                                              ("xml/TDM-data-wrong-keyword.xml", 47, 6)])
+def test_wrong_data_keyword_is_reported_in_both_syntaxes(shared_data, name, line, rows):
+    d = tdm.read(shared_data / "tdm" / name, errors="report")
+    assert [(e.line, e.record) for e in d.report] == [(line, "WRONG_KEYWORD")]
+    assert len(d.table) == rows

@@ -104,3 +104,36 @@ def test_malformed_cards_raise_with_line(card, words):
 def test_complex_of_station():
     assert [complex_of(s) for s in ("DSS-14", "25", 34, "DSS-43", "DSS-65", "C60", "BRKS")] == \
         ["C10", "C10", "C40", "C40", "C60", "C60", ""]
+
+
+_CARD = ("ADJUST(ALL)BY CONST(0.002)MODEL(DRY NUPART)FROM(06/02/01,00:00)TO(06/02/02,00:00)DSN(C10).\n")
+
+
+@pytest.mark.parametrize("fitsig", [".", "1e400", "nan", "", "9" * 5000])
+def test_bad_fitsig_is_a_parse_error_and_reported(tmp_path, fitsig):
+    p = tmp_path / "bad.tro"
+    p.write_text(f"# FITSIG= {fitsig}\n{_CARD}# FITSIG= .0012\n{_CARD}")
+    with pytest.raises(ParseError) as err:
+        read_trk223(p)
+    assert err.value.line == 1 and "FITSIG" in err.value.reason
+    report = ParseReport()
+    cs = read_trk223(p, errors="report", report=report)
+    assert [e.line for e in report] == [1]
+    assert np.isnan(cs.cards[0].fitsig) and cs.cards[1].fitsig == 0.0012  # both cards kept
+
+
+@pytest.mark.parametrize("coef", ["1e400", "nan", "-inf"])
+def test_non_finite_coefficient_is_a_parse_error(tmp_path, coef):
+    p = tmp_path / "bad.tro"
+    p.write_text(_CARD.replace("0.002", coef))
+    with pytest.raises(ParseError, match="finite"):
+        read_trk223(p)
+
+
+@pytest.mark.parametrize("text", [b"", b"  \n", b"# FITSIG= .001\n", b"\xff" + _CARD.encode()])
+def test_empty_or_not_ascii_is_a_parse_error_in_both_modes(tmp_path, text):
+    p = tmp_path / "x.tro"
+    p.write_bytes(text)
+    for mode in ("raise", "report"):
+        with pytest.raises(ParseError):
+            read_trk223(p, errors=mode, report=ParseReport())

@@ -16,10 +16,7 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 import pytest
-from hypothesis import HealthCheck, given, settings
-from hypothesis import strategies as st
 
-from tests.fuzzing import mutated
 from parsers import ParseError, utdf
 
 C_KM_S = 299792.458
@@ -176,28 +173,6 @@ def test_sniff(shared_data):
     assert not utdf.sniff((shared_data / "messenger/odf07155.odf").read_bytes()[:80])
 
 
-@pytest.fixture(scope="module")
-def utdf_head(shared_data):
-    return (shared_data / LSUTDF).read_bytes()[: 75 * 40]
-
-
-@pytest.mark.realdata
-@settings(max_examples=150, deadline=None, suppress_health_check=[HealthCheck.function_scoped_fixture])
-@given(data=st.data())
-def test_fuzz_only_parse_errors(utdf_head, tmp_path_factory, data):
-    buf = mutated(data, utdf_head)
-    p = tmp_path_factory.mktemp("fuzz") / "f.utdf"
-    p.write_bytes(bytes(buf))
-    for mode in ("raise", "report"):
-        try:
-            d = utdf.read(p, errors=mode)
-        except ParseError:
-            continue
-        assert len(d.meta["records"]) <= len(buf) // 75
-        assert utdf.encode(d.meta["records"]) == b"".join(
-            bytes(buf[i * 75:(i + 1) * 75]) for i in d.meta["records"].index)
-
-
 def test_running_count_is_not_differenced_across_a_pass_gap(tmp_path):
     # The writer's records twice, a day apart: the first record of the second pass starts a new
     # series instead of averaging the Doppler over the whole gap between passes.
@@ -210,3 +185,27 @@ def test_running_count_is_not_differenced_across_a_pass_gap(tmp_path):
     n = len(dop) // 2
     assert np.isnan(dop["value"].iloc[n])
     np.testing.assert_array_equal(dop["count_time"].iloc[n + 1:], dop["count_time"].iloc[1:n])
+
+
+@pytest.mark.realdata
+def test_duplicated_record_is_flagged_not_dropped(shared_data, tmp_path):
+    from parsers import table as tt
+    buf = (shared_data / LSUTDF).read_bytes()[:75 * 10]
+    p = tmp_path / "dup.utdf"
+    p.write_bytes(buf[:75 * 5] + buf[75 * 3:75 * 4] + buf[75 * 5:])  # record 3 again as record 5
+    d = utdf.read(p)
+    (tmp_path / "once.utdf").write_bytes(buf)
+    once = utdf.read(tmp_path / "once.utdf")
+    dup = (d.table["flags"] & tt.DUPLICATE) != 0
+    assert set(d.table.loc[dup, "record"]) == {5}
+    assert dup.sum() == (once.table["record"] == 3).sum() > 0
+    assert not ((once.table["flags"] & tt.DUPLICATE) != 0).any()
+
+
+@pytest.mark.parametrize("blob", [b"", b"\x0d\x0a\x01" + b"\x00" * 40])
+def test_empty_file_is_a_parse_error_in_both_modes(tmp_path, blob):
+    p = tmp_path / "empty.utdf"
+    p.write_bytes(blob)
+    for mode in ("raise", "report"):
+        with pytest.raises(ParseError, match="no UTDF record"):
+            utdf.read(p, errors=mode)

@@ -57,3 +57,16 @@ def evaluate(table: pd.DataFrame) -> tuple[pd.DataFrame, pd.DataFrame]:
                           for name in COLUMNS},  # NaN skipped; all-NaN columns stay NaN
                          index=["Average", "Median", "Max", "Min"])
     return rows, stats
+
+
+def report_tables(rows: pd.DataFrame, stats: pd.DataFrame, epochs_utc=None) -> list[tuple[str, pd.DataFrame, dict]]:
+    """(caption, table, formats) of :func:`evaluate`'s rows and summary for a report: mm/s to the µm/s,
+    percentages to 0.01 %; ``epochs_utc`` (datetime64, one per row) adds each maneuver's epoch."""
+    per = rows.copy()
+    if epochs_utc is not None:
+        per.insert(1, "epoch (UTC)", np.asarray(epochs_utc, "datetime64[ns]"))
+    formats = {c: "{:.3f}" if "mm/s" in c else "{:.2f}" for c in list(per.columns) + COLUMNS
+               if "mm/s" in c or "%" in c}
+    summary = stats.reset_index().rename(columns={"index": "statistic"})
+    return [("per maneuver", per, formats), ("over all maneuvers (a percentage of a zero design is undefined: –)",
+                                             summary, formats)]

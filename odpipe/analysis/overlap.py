@@ -22,6 +22,7 @@ from parsers import oem
 _J2000 = np.datetime64("2000-01-01T12:00:00", "ns")
 
 COMPONENTS = ("radial", "intrack", "crosstrack")
+EDGE = 2e-6  # s: products start and end on whole microseconds inside their arc (pipeline.products.product_epochs)
 
 
 class SampledTrajectory:
@@ -43,7 +44,7 @@ class SampledTrajectory:
 
     def state(self, t_tdb):
         t = np.atleast_1d(np.asarray(t_tdb, dtype=float))
-        if np.any(t < self.t0 - 1e-6) or np.any(t > self.t1 + 1e-6):
+        if np.any(t < self.t0 - EDGE) or np.any(t > self.t1 + EDGE):
             raise ValueError(f"epoch outside the trajectory span [{self.t0}, {self.t1}] s TDB")
         return np.hstack([self._spline(t), self._dspline(t)])
 
@@ -134,6 +135,29 @@ def summarize(overlaps: list[Overlap]) -> pd.DataFrame:
     return pd.concat([table, pd.DataFrame([mean, std])], ignore_index=True)
 
 
+def report_tables(table: pd.DataFrame) -> list[tuple[str, pd.DataFrame, dict]]:
+    """(caption, table, formats) of a :func:`summarize` table for a report: per overlap its span (UTC)
+    and the RIC RMS, 3D RMS and 3D maximum differences, position in m and velocity in mm/s to the
+    mm and µm/s; then the mean and standard deviation over the overlaps, without the span columns."""
+    from odpipe.time import tdb_to_utc
+
+    each = table[~table["overlap"].isin(["mean", "std"])]
+    out = pd.DataFrame({"overlap": each["overlap"],
+                        "start (UTC)": np.asarray(tdb_to_utc(each["t_start_tdb"].to_numpy(float)), "datetime64[ns]"),
+                        "end (UTC)": np.asarray(tdb_to_utc(each["t_end_tdb"].to_numpy(float)), "datetime64[ns]"),
+                        "duration (h)": each["hours"]})
+    figures = pd.DataFrame({"overlap": table["overlap"]})
+    names = {"radial_rms": "radial RMS", "intrack_rms": "in-track RMS", "crosstrack_rms": "cross-track RMS",
+             "3d_rms": "3D RMS", "3d_max": "3D max"}
+    for kind, what, scale, unit in (("pos", "position", 1.0, "m"), ("vel", "velocity", 1e3, "mm/s")):
+        for key, name in names.items():
+            figures[f"{what} {name} ({unit})"] = table[f"{kind}_{key}"] * scale
+    formats = {c: "{:.3f}" for c in figures.columns[1:]} | {"duration (h)": "{:.1f}"}
+    stats = figures[figures["overlap"].isin(["mean", "std"])].rename(columns={"overlap": "statistic"})
+    return [("per overlap", pd.concat([out, figures.loc[each.index].drop(columns="overlap")], axis=1), formats),
+            ("over all overlaps", stats, formats)]
+
+
 def consecutive_overlaps(trajs: dict, order, out, label: str, title: str = "", step: float = 600.0):
     """Overlaps of consecutive arcs in ``order`` (names in ``trajs``) whose spans overlap: the
     summary table written to ``out/overlap_{label}.csv`` and its position and velocity plots.
@@ -186,7 +210,7 @@ def plot_overlaps(summary: pd.DataFrame, path, kind: str = "pos", title: str = "
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
 
-    from odpipe.products.atomic import atomic_path
+    from odpipe.products.atomic import save_figure
 
     rows = summary[~summary["overlap"].isin(["mean", "std"])]
     labels = ["Radial", "In-track", "Cross-track", "3D RMS"]
@@ -198,10 +222,10 @@ def plot_overlaps(summary: pd.DataFrame, path, kind: str = "pos", title: str = "
         ax.bar(x + (k - 1.5) * 0.2, rows[col] * scale, width=0.2, label=label)
     ax.set_xticks(x, rows["overlap"], rotation=30, ha="right")
     ax.set_ylabel(f"RMS difference ({unit})")
+    ax.set_xlabel("overlap (arc A − arc B)")
     ax.set_title(title or ("Position" if kind == "pos" else "Velocity") + " overlap differences")
     ax.legend()
     ax.grid(axis="y", alpha=0.3)
     fig.tight_layout()
-    with atomic_path(path) as tmp:
-        fig.savefig(tmp, format="png", dpi=110)
+    save_figure(path, fig, dpi=110)
     plt.close(fig)

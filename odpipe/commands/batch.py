@@ -3,35 +3,53 @@
 and the overlaps of consecutive arcs (RIC, 3D RMS) with their plots; ``overlaps = [globs]`` limits the
 overlap sequence to those arcs (e.g. leaving out a start-up arc that spans the same day as another)."""
 
-import tomllib
 from pathlib import Path
 
-import pandas as pd
-
-from odpipe.analysis.overlap import consecutive_overlaps, oem_trajectory
-from odpipe.pipeline.config import load_config
-from odpipe.pipeline.setup import tdb
-from odpipe.pipeline.run import run_config
-from odpipe.runs.batch import night_summary, run_batch
-from odpipe.runs.report import Section, write_report
-from odpipe.runs.schema import ConfigError
+from odpipe.errors import Exit, describe
+from odpipe.pipeline.config import RunSection, load_config
+from odpipe.runs.batch import load_batch, night_summary, run_batch
+from odpipe.runs.schema import load, read_toml
 
 NAME = "batch"
 HELP = ("run many arcs (a nightly batch config listing arc configs) in parallel; skips arcs whose config, "
-        "inputs and software are unchanged")
+        "inputs and software are unchanged; an arc that fails (or whose config does not load) never stops the rest")
 
 
 def add_arguments(p):
-    p.add_argument("config", type=Path, help="batch config: [batch] arcs = [run configs or globs], workers = N")
+    p.add_argument("config", type=Path, help="batch config: [batch] arcs = [run configs or globs, relative to "
+                                             "the batch config or absolute], workers = N, report = folder")
     p.add_argument("--scheduler", help="address of a running Dask scheduler (default: a local cluster)")
     p.add_argument("--workers", type=int, help="local cluster size (default: the config's, else 2)")
     p.add_argument("--force", action="store_true", help="refit every arc, even unchanged ones")
 
 
-def starts_from(arcs: list[Path]) -> dict:
-    """arc -> the arcs of the batch whose products its a priori state is read from."""
-    cfgs = {a: load_config(a) for a in arcs}
+def arc_configs(arcs: list[Path]) -> tuple[dict, dict]:
+    """(arc -> RunConfig of the arcs whose configuration loads, arc -> one line saying why the others do not)."""
+    cfgs, broken = {}, {}
+    for a in arcs:
+        try:
+            cfgs[a] = load_config(a)
+        except (ValueError, OSError) as exc:  # ConfigError (every problem), unreadable or absent file
+            broken[a] = describe(exc)[1]
+    return cfgs, broken
+
+
+def _root(arc: Path) -> Path | None:
+    """The run folder of an arc whose configuration does not load, if its [run] table says it."""
+    try:
+        data, _ = read_toml(arc)
+        run = load(RunSection, data.get("run"), Path(arc).resolve(), "run")
+    except (ValueError, OSError):
+        return None
+    return (run.output / run.name).resolve()
+
+
+def starts_from(arcs: list[Path], cfgs: dict | None = None, broken=()) -> dict:
+    """arc -> the arcs of the batch whose products its a priori state is read from (``cfgs``: the loaded
+    configurations, default: load them; ``broken``: arcs whose configuration does not load)."""
+    cfgs = {a: load_config(a) for a in arcs} if cfgs is None else cfgs
     roots = {a: (c.run.output / c.run.name).resolve() for a, c in cfgs.items()}
+    roots.update({a: root for a in broken if (root := _root(a)) is not None})
     after = {}
     for a, c in cfgs.items():
         source = c.initial_state.from_oem
@@ -43,13 +61,23 @@ def starts_from(arcs: list[Path]) -> dict:
 def night_report(out: Path, arcs: list[Path], outcomes, overlap_arcs: list[Path] | None = None) -> Path:
     """The night's report in ``out``: residual statistics per arc and station, overlaps of consecutive
     arcs among ``overlap_arcs`` (default all)."""
+    import pandas as pd
+
+    from odpipe.analysis.overlap import consecutive_overlaps, oem_trajectory, report_tables
+    from odpipe.pipeline.setup import tdb
+    from odpipe.products import residuals
+    from odpipe.products.atomic import write_csv
+    from odpipe.runs.report import Section, write_report
+
     out.mkdir(parents=True, exist_ok=True)
     status = {Path(o.config).resolve(): o for o in outcomes}
     done = []
     for a in arcs:
+        if status[a.resolve()].status == "failed":
+            continue
         cfg = load_config(a)
         run = cfg.run.output / cfg.run.name / "current"
-        if status[a.resolve()].status != "failed" and (run / "trajectory.oem").exists():
+        if (run / "trajectory.oem").exists():
             done.append((tdb(cfg.arc.start), cfg.run.name, run, a))
     done.sort()
     stats = pd.concat([pd.read_csv(run / "residual_statistics.csv").assign(arc=name) for _, name, run, _ in done],
@@ -58,15 +86,16 @@ def night_report(out: Path, arcs: list[Path], outcomes, overlap_arcs: list[Path]
     sections = []
     if not stats.empty:
         stats = stats[["arc"] + [c for c in stats.columns if c != "arc"]]
-        stats.to_csv(out / "residual_statistics.csv", index=False)
+        write_csv(out / "residual_statistics.csv", stats, index=False)
         sections.append(Section("Post-fit residuals per arc and station").text(
-            "postfit_rms along the line of sight (m or m/s), postfit_rms_unit in the observable's unit (m, Hz, RU); "
-            "per pass in each run's residual_statistics_passes.csv").table(stats))
+            "Along the line of sight (Doppler mm/s, range m), and the post-fit RMS in the observable's unit; "
+            "per pass in each run's residual_statistics_passes.csv").tables(residuals.report_tables(stats)))
     seq = [(name, run) for _, name, run, a in done if overlap_arcs is None or a in overlap_arcs]
     table, pngs = consecutive_overlaps({name: oem_trajectory(run / "trajectory.oem") for name, run in seq},
                                        [name for name, _ in seq], out, "arcs", "Consecutive-arc", step=60.0)
     if table is not None:
-        sec = Section("Overlaps of consecutive arcs (RIC differences, A - B over each overlap)").table(table)
+        sec = Section("Overlaps of consecutive arcs (RIC differences, A - B over each overlap)").tables(
+            report_tables(table))
         for png in pngs:
             sec.figure(png, png.stem)
         sections.append(sec)
@@ -80,30 +109,25 @@ def night_report(out: Path, arcs: list[Path], outcomes, overlap_arcs: list[Path]
 
 
 def _arc(path: Path) -> dict:
+    from odpipe.pipeline.run import run_config
     return run_config(path, progress=None)
 
 
 def _arc_forced(path: Path) -> dict:
+    from odpipe.pipeline.run import run_config
     return run_config(path, force=True, progress=None)
 
 
 def run(args) -> int:
-    data = tomllib.loads(args.config.read_text())
-    batch = data.get("batch")
-    if not isinstance(batch, dict) or not isinstance(batch.get("arcs"), list):
-        raise ConfigError(args.config, "batch.arcs", "a list of run configs is required")
-    allowed = {"arcs", "workers", "report", "overlaps"}
-    if set(batch) - allowed:
-        raise ConfigError(args.config, f"batch.{sorted(set(batch) - allowed)[0]}",
-                          f"unknown key (allowed: {', '.join(sorted(allowed))})")
-    arcs = sorted({p for pattern in batch["arcs"] for p in args.config.parent.glob(pattern)})
-    overlap_arcs = (None if "overlaps" not in batch
-                    else {p for pattern in batch["overlaps"] for p in args.config.parent.glob(pattern)})
-    if not arcs:
-        raise ConfigError(args.config, "batch.arcs", "no run config matches")
-    outcomes = run_batch(arcs, _arc_forced if args.force else _arc, after=starts_from(arcs), scheduler=args.scheduler,
-                         workers=args.workers or batch.get("workers", 2))
+    batch = load_batch(args.config)
+    if args.workers is not None and args.workers < 1:
+        raise ValueError(f"--workers {args.workers}: must be at least 1")
+    arcs = sorted(set(batch.arcs))
+    overlap_arcs = None if batch.overlaps is None else set(batch.overlaps)
+    cfgs, broken = arc_configs(arcs)
+    outcomes = run_batch(arcs, _arc_forced if args.force else _arc, after=starts_from(arcs, cfgs, broken),
+                         scheduler=args.scheduler, workers=args.workers or batch.workers, failed=broken)
     print(night_summary(outcomes))
-    if "report" in batch:
-        print(f"report: {night_report(args.config.parent / batch['report'], arcs, outcomes, overlap_arcs)}")
-    return 1 if any(o.status == "failed" for o in outcomes) else 0
+    if batch.report is not None:
+        print(f"report: {night_report(batch.report, arcs, outcomes, overlap_arcs)}")
+    return Exit.PARTIAL if any(o.status == "failed" for o in outcomes) else Exit.OK

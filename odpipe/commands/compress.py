@@ -2,11 +2,16 @@
 
 from __future__ import annotations
 
+import logging
+
+from odpipe.commands._inputs import read_table
+from odpipe.pipeline.geometry import median_round_trip
 from odpipe.preprocess import store
 from odpipe.preprocess.compress import compress
 
 NAME = "compress"
 HELP = "compress Doppler to a longer count time (exact averages / phase differences)"
+log = logging.getLogger(__name__)
 
 
 def add_arguments(parser) -> None:
@@ -16,14 +21,18 @@ def add_arguments(parser) -> None:
     parser.add_argument("--partial", choices=("keep", "flag", "drop"), default="keep",
                         help="short windows: keep as shorter counts, flag them, or drop and report")
     parser.add_argument("--max-gap", type=float, default=600.0, help="pass break at gaps longer than this, s")
-    parser.add_argument("--ramp-delay", type=float, default=0.0,
-                        help="s between a ramp change at the transmitter and its effect on the data (round-trip light time)")
+    parser.add_argument("--ramp-delay", type=float,
+                        help="s between a ramp change at the transmitter and its effect on the data (default: "
+                             "the median round-trip light time of the rtlt_s column, as odpipe run uses; else 0)")
 
 
 def run(args) -> int:
-    table, ramps = store.read(args.input)
+    table, ramps = read_table(args.input)
+    delay = median_round_trip(table) if args.ramp_delay is None else args.ramp_delay
+    if args.ramp_delay is None:
+        log.info("ramp delay %.3f s (%s)", delay, "median rtlt_s" if "rtlt_s" in table else "no rtlt_s column")
     out, report = compress(table, args.count_time, ramps=ramps, partial=args.partial, max_gap=args.max_gap,
-                           ramp_delay=args.ramp_delay)
+                           ramp_delay=delay)
     store.write(args.output, out, ramps)
     print("\n".join(report.lines()))
     return 0

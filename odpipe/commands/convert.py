@@ -4,6 +4,7 @@ from __future__ import annotations
 
 from pathlib import Path
 
+from odpipe.commands._inputs import read_table
 from odpipe.preprocess import store
 from odpipe.products.tdm import to_tdm
 from parsers import formats
@@ -24,7 +25,7 @@ def add_arguments(parser) -> None:
 def load(path, errors: str = "raise") -> TrackingData:
     """TrackingData from a TrackingTable Parquet file or any file a reader recognises."""
     if str(path).endswith(".parquet"):
-        return TrackingData(*store.read(path))
+        return TrackingData(*read_table(path))
     data = formats.read_any(path, errors=errors)
     if not isinstance(data, TrackingData):
         raise ValueError(f"{path} is not tracking data")
@@ -32,15 +33,13 @@ def load(path, errors: str = "raise") -> TrackingData:
 
 
 def run(args) -> int:
-    try:
-        data = load(args.input, args.errors)
-    except (OSError, ValueError) as exc:  # ParseError is a ValueError; so is a file that holds no tracking data
-        print(f"error: {exc}")
-        return 1
     suffix = Path(args.output).suffix.lower()
+    if suffix != ".parquet" and suffix not in TDM_SYNTAX:
+        raise ValueError(f"{args.output}: cannot write {suffix!r} files: name OUT.parquet, OUT.tdm, OUT.kvn or OUT.xml")
+    data = load(args.input, args.errors)  # a ParseError, or a file with no tracking data: the CLI's one line
     if suffix == ".parquet":
         written = store.write(args.output, data.table, data.ramps)
-    elif suffix in TDM_SYNTAX:
+    else:
         from parsers import tdm
 
         if "segments" not in data.meta:  # not read from a TDM: map the table onto TDM keywords
@@ -49,8 +48,5 @@ def run(args) -> int:
                 print(f"not written (no TDM keyword, or no value): {skipped['observable'].value_counts().to_dict()}")
         tdm.write(args.output, data, syntax=TDM_SYNTAX[suffix])
         written = [args.output]
-    else:
-        print(f"cannot write {suffix!r}: use .parquet, .tdm, .kvn or .xml")
-        return 2
     print(f"{len(data.table)} rows -> {', '.join(map(str, written))}; {len(data.report)} records reported unreadable")
     return 0

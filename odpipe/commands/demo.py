@@ -1,12 +1,15 @@
 """odpipe demo: the embedded ARTEMIS-like case end to end (what `make demo` runs)."""
 
+import logging
 import time
 from pathlib import Path
 
-from odpipe.pipeline.demo import run_demo
+from odpipe.errors import Exit
 
 NAME = "demo"
 HELP = "simulate the embedded ARTEMIS-like case, fit short and long arcs, overlaps, maneuvers, truth comparison"
+
+_log = logging.getLogger(__name__)
 
 
 def add_arguments(p):
@@ -15,8 +18,10 @@ def add_arguments(p):
 
 
 def run(args) -> int:
+    from odpipe.pipeline.demo import run_demo
+
     t0 = time.perf_counter()
-    headline = run_demo(args.out, args.workers)
+    headline = run_demo(args.out, args.workers, progress=_log.info)
     print("\n".join(f"{k}: {v}" for k, v in headline.items()))
-    print(f"demo finished in {time.perf_counter() - t0:.0f} s; open {headline['report']}")
-    return 0
+    _log.info("demo finished in %.0f s; open %s", time.perf_counter() - t0, headline["report"])
+    return Exit.OK

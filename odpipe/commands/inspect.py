@@ -3,12 +3,14 @@
 from __future__ import annotations
 
 import importlib
+import logging
 
 import pandas as pd
 
 from parsers import formats
 from parsers.errors import ParseReport
 from parsers.table import TrackingData
+from odpipe.errors import Exit, describe
 from odpipe.preprocess import ramp_segments, store
 from odpipe.preprocess.edit import duplicates, invalid
 from odpipe.preprocess.passes import assign_passes
@@ -16,6 +18,8 @@ from odpipe.preprocess.passes import assign_passes
 NAME = "inspect"
 HELP = "detect a file's format and summarize its contents and anomalies"
 SHOWN_ERRORS = 5
+
+_log = logging.getLogger(__name__)
 
 
 def add_arguments(parser) -> None:
@@ -66,7 +70,7 @@ def summarize(path) -> list[str]:
         return ["format: TrackingTable Parquet"] + tracking_summary(TrackingData(table, ramps))
     name = formats.detect(path)
     if name is None:
-        return [f"format: not recognised (readers available: {', '.join(formats.available())})"]
+        raise ValueError(f"{path}: format not recognised (readers available: {', '.join(formats.available())})")
     report = ParseReport()
     mod = importlib.import_module(name)
     if hasattr(mod, "describe"):  # a reader of something other than tracking data (CPF, SINEX)
@@ -84,12 +88,19 @@ def summarize(path) -> list[str]:
 
 
 def run(args) -> int:
+    """Summaries on stdout; a file that cannot be read or recognised is one error line on stderr
+    (the others are still summarized) and makes the status Exit.INPUT."""
     failed = 0
     for path in args.files:
-        print(f"== {path}")
         try:
-            print("\n".join(summarize(path)))
-        except (OSError, ValueError) as exc:  # ParseError is a ValueError
+            lines = summarize(path)
+        except Exception as exc:
+            code, line = describe(exc)
+            if code == Exit.INTERNAL:
+                raise
             failed += 1
-            print(f"error: {exc}")
-    return 1 if failed else 0
+            _log.error(line)
+            continue
+        print(f"== {path}")
+        print("\n".join(lines))
+    return Exit.INPUT if failed else Exit.OK

@@ -4,15 +4,14 @@ from __future__ import annotations
 
 from pathlib import Path
 
-from odpipe.analysis.overlap import compare, oem_trajectory, plot_overlaps, summarize
-from odpipe.products.atomic import write_text
+from odpipe.errors import Exit
 
 NAME = "overlap"
 HELP = "overlap precision (RIC, 3D RMS) between consecutive arcs' OEM solutions"
 
 
 def add_arguments(p):
-    p.add_argument("oem", nargs="+", type=Path, help="OEM files of consecutive arcs, in arc order")
+    p.add_argument("oem", nargs="+", type=Path, help="OEM files of consecutive arcs, in arc order (at least two)")
     p.add_argument("-o", "--out", type=Path, default=Path("overlap"), help="output folder")
     p.add_argument("--step", type=float, default=600.0, help="comparison grid step (s)")
 
@@ -27,8 +26,13 @@ def _labels(paths) -> list[str]:
 
 
 def run(args) -> int:
+    from odpipe.analysis.overlap import compare, oem_trajectory, plot_overlaps, summarize
+    from odpipe.products.atomic import write_text
+
     if len(args.oem) < 2:
-        raise SystemExit("odpipe overlap needs at least two OEM files")
+        raise ValueError(f"odpipe overlap needs at least two OEM files, got {len(args.oem)}")
+    if not args.step > 0:
+        raise ValueError(f"--step {args.step}: must be positive (s)")
     trajs = [oem_trajectory(p) for p in args.oem]
     names = _labels(args.oem)
     overlaps = [compare(a, b, f"{na} - {nb}", args.step)
@@ -42,4 +46,4 @@ def run(args) -> int:
     print(f"{len(overlaps)} overlaps; position 3D RMS {mean.pos_3d_rms:.3f} ± {std.pos_3d_rms:.3f} m, "
           f"velocity 3D RMS {mean.vel_3d_rms * 1e3:.4f} ± {std.vel_3d_rms * 1e3:.4f} mm/s")
     print(f"table and plots in {args.out}/")
-    return 0
+    return Exit.OK

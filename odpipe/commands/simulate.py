@@ -4,6 +4,8 @@ from __future__ import annotations
 
 from pathlib import Path
 
+from odpipe.errors import Exit
+
 NAME = "simulate"
 HELP = "simulate a tracking case (e.g. runs/artemis_p2_like.toml) into a directory"
 
@@ -17,9 +19,11 @@ def add_arguments(parser) -> None:
 def run(args) -> int:
     from odpipe.simulate import run_case
 
+    if args.days is not None and not args.days > 0:
+        raise ValueError(f"--days {args.days}: must be positive")
     paths, truth, obs = run_case(args.case, args.output, days=args.days)
     t = obs.table
     print(f"{len(t)} observables in {t['pass_id'].nunique()} passes, {len(truth.epochs)} maneuvers; files:")
     for role, p in paths.items():
         print(f"  {role}: {p}")
-    return 0
+    return Exit.OK

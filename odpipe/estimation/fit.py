@@ -20,10 +20,16 @@ Each iteration is one filter pass and one smoother pass about a reference; the
 next reference starts from the smoothed epoch vector and takes the smoothed
 stochastic values after each batch boundary. The fit stops when every epoch
 correction is below ``tol_dx`` of its sigma and the post-fit RMS is stable.
+
+A row whose value or sigma is not finite, whose sigma is not positive, or whose
+computed value or partials are not finite is flagged ``NONFINITE`` and not used;
+a fit left with no usable row, or whose data carry no information about any
+estimated parameter (every row deweighted), raises :class:`NothingToFit`.
 """
 
 from __future__ import annotations
 
+import logging
 from dataclasses import dataclass
 from typing import Protocol
 
@@ -35,8 +41,12 @@ from .smoother import smooth_arrays
 from .solution import Solution, checksum
 from .srif import SRIF, information_estimate, solve_information
 
+_log = logging.getLogger(__name__)
+
 EDIT_INNOVATION = 1  # row rejected by the innovation (pre-fit) k-sigma test
 OUTSIDE_ARC = 2      # row time outside [t_start, t_end]
+NONFINITE = 4        # value, sigma, computed value or partials not finite, or sigma <= 0
+NO_INFORMATION = 1e-9  # relative variance reduction below which an estimated parameter learned nothing
 
 
 class Problem(Protocol):
@@ -125,6 +135,20 @@ class FitDiverged(RuntimeError):
     """The iterations drove the reference where the models cannot be evaluated."""
 
 
+class NothingToFit(FitDiverged):
+    """No usable row is left (all outside the arc, not finite or edited), or the rows carry no information."""
+
+
+def _nothing_left(flags: np.ndarray, it: int) -> str:
+    """Why no row is used, counted by reason (``flags`` of one pass)."""
+    n = flags.size
+    parts = [f"{np.count_nonzero(flags & bit)} {what}" for bit, what in
+             ((OUTSIDE_ARC, "outside the arc"), (NONFINITE, "with a non-finite value, sigma or computed value "
+                                                 "or a sigma <= 0"), (EDIT_INNOVATION, "edited by the innovation test"))
+             if np.any(flags & bit)]
+    return f"iteration {it + 1}: nothing left to fit: of {n} rows, " + (", ".join(parts) or "none given")
+
+
 @dataclass
 class _Pass:
     """One filter-smoother pass about a reference."""
@@ -140,12 +164,18 @@ class _Pass:
     innovation_sigma: np.ndarray
 
 
+def _unusable(obs: Observations) -> np.ndarray:
+    """Rows that cannot be weighted: value or sigma not finite, or sigma not positive."""
+    return ~np.isfinite(obs.value) | ~np.isfinite(obs.sigma) | ~(obs.sigma > 0)
+
+
 def _filter_smoother_pass(problem, obs, grid, steps, bounds, x_ref0, p_after, sig_row, edit_k):
     reg = problem.registry
     m_obs = obs.time.size
     flags = np.zeros(m_obs, int)
     flags[: bounds[0]] |= OUTSIDE_ARC
     flags[bounds[-1]:] |= OUTSIDE_ARC
+    unusable = _unusable(obs) | ~np.isfinite(sig_row) | ~(sig_row > 0)
     prefit, innov, innov_sig = (np.full(m_obs, np.nan) for _ in range(3))
     srif = SRIF.from_apriori(reg.sigma, dx=reg.apriori - x_ref0, n_est=reg.n_estimated)
     xr = x_ref0.copy()
@@ -164,11 +194,16 @@ def _filter_smoother_pass(problem, obs, grid, steps, bounds, x_ref0, p_after, si
         if rows.size:
             computed, H = problem.predict(grid[k], xr, rows)
             y = obs.value[rows] - computed
-            nu, s = srif.innovations(H, y, sig_row[rows])
-            bad = np.abs(nu) > edit_k * s
+            nonfinite = unusable[rows] | ~np.isfinite(y) | ~np.isfinite(H).all(axis=1)
+            flags[rows[nonfinite]] |= NONFINITE
+            use = ~nonfinite
+            nu, s = np.full(rows.size, np.nan), np.full(rows.size, np.nan)
+            nu[use], s[use] = srif.innovations(H[use], y[use], sig_row[rows][use])
+            bad = use & (np.abs(nu) > edit_k * s)
             flags[rows[bad]] |= EDIT_INNOVATION
             prefit[rows], innov[rows], innov_sig[rows] = y, nu, s
-            srif.measurement_update(H[~bad], y[~bad], sig_row[rows][~bad])
+            keep = use & ~bad
+            srif.measurement_update(H[keep], y[keep], sig_row[rows][keep])
             blocks.append((k, rows, H, y))
         xr, Phi = problem.transition(grid[k], grid[k + 1], xr)
         srif.time_update(Phi)
@@ -176,6 +211,12 @@ def _filter_smoother_pass(problem, obs, grid, steps, bounds, x_ref0, p_after, si
     srif.mark(K)
     filt.append((srif.R, srif.z))
     return _Pass(srif, refs, filt, smooth_arrays(srif), blocks, flags, prefit, innov, innov_sig)
+
+
+def _symmetric(P) -> np.ndarray:
+    """Covariances (K, n, n) made exactly symmetric (their products of factors differ by rounding)."""
+    P = np.asarray(P)
+    return 0.5 * (P + P.transpose(0, 2, 1))
 
 
 def _gaussian(ps: _Pass, R, z):
@@ -228,20 +269,30 @@ def fit(problem: Problem, obs: Observations, t_start: float, t_end: float,
                 halvings += 1
         needed = {0} | {b[0] for b in ps.blocks} | set(steps)
         dx = {k: _estimate(ps, *ps.smoothed[k]) for k in needed}
+        ok = ps.flags == 0
+        if not ok.any():
+            raise NothingToFit(_nothing_left(ps.flags, it))
         postfit = np.full(obs.time.size, np.nan)
         for k, rows, H, y in ps.blocks:
-            postfit[rows] = y - H @ dx[k]
-        ok = ps.flags == 0
+            with np.errstate(invalid="ignore"):   # non-finite rows stay NaN
+                postfit[rows] = y - H @ dx[k]
         rms = float(np.sqrt(np.mean((postfit[ok] / sig_row[ok]) ** 2)))
         P0 = _gaussian(ps, *ps.smoothed[0]).P
+        if np.all(np.diag(P0)[:n_est] >= reg.sigma[:n_est] ** 2 * (1.0 - NO_INFORMATION)):
+            raise NothingToFit(f"iteration {it + 1}: the {int(ok.sum())} rows used carry no information about "
+                               f"any estimated parameter (every row deweighted?); sigmas "
+                               f"{np.nanmin(sig_row[ok]):.3g}..{np.nanmax(sig_row[ok]):.3g}")
         corr = np.max(np.abs(dx[0][:n_est]) / np.sqrt(np.diag(P0)[:n_est]))
         history.append({"iteration": it + 1, "postfit_rms": rms,
                         "prefit_rms": float(np.sqrt(np.mean((ps.prefit[ok] / sig_row[ok]) ** 2))),
                         "edited": int(np.sum(ps.flags & EDIT_INNOVATION > 0)),
+                        "nonfinite": int(np.sum(ps.flags & NONFINITE > 0)),
                         "max_correction_sigma": float(corr), "edit_k": float(kk),
                         "sigma_scale": float(options.sigma_scale[stage]),
                         "halvings": halvings,
                         "scales": {str(g): float(v) for g, v in scale.items()}})
+        _log.info("fit iteration %d: post-fit RMS %.4g sigma (pre-fit %.4g), %d rows edited, largest epoch "
+                  "correction %.3g sigma", it + 1, rms, history[-1]["prefit_rms"], history[-1]["edited"], corr)
         # relinearize about the smoothed solution
         step_x = np.zeros_like(x_ref0)
         step_x[:n_est] = dx[0][:n_est]
@@ -282,10 +333,10 @@ def fit(problem: Problem, obs: Observations, t_start: float, t_end: float,
     return Solution(
         names=reg.names, grid=grid,
         filtered_x=refs + np.array([g.x for g in filt]),
-        filtered_P=np.array([g.P_consider for g in filt]),
+        filtered_P=_symmetric([g.P_consider for g in filt]),
         smoothed_x=refs + np.array([g.x for g in sm]),
-        smoothed_P=np.array([g.P for g in sm]),
-        smoothed_P_consider=np.array([g.P_consider for g in sm]),
+        smoothed_P=_symmetric([g.P for g in sm]),
+        smoothed_P_consider=_symmetric([g.P_consider for g in sm]),
         residuals=residuals, history=history, converged=converged,
         inputs={"observations": checksum(obs.time, obs.value, obs.sigma),
                 "apriori": checksum(reg.apriori, reg.sigma),

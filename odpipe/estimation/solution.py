@@ -10,6 +10,7 @@ covariances are (K, n, n). ``residuals`` has one row per observation: ``time``,
 from __future__ import annotations
 
 import hashlib
+import io
 import json
 from dataclasses import dataclass, field
 
@@ -65,15 +66,14 @@ class Solution:
 
     def save(self, path) -> None:
         """Write atomically to one ``.npz`` (arrays, residual columns, history as JSON)."""
-        from odpipe.products.atomic import atomic_path
+        from odpipe.products.atomic import write_bytes
 
         meta = {"names": list(self.names), "history": self.history,
                 "converged": self.converged, "inputs": self.inputs}
         cols = {f"res_{c}": _plain(self.residuals[c].to_numpy()) for c in self.residuals.columns}
-        with atomic_path(path) as tmp:
-            with open(tmp, "wb") as f:
-                np.savez(f, meta=json.dumps(meta, default=_jsonable),
-                         **{a: getattr(self, a) for a in _ARRAYS}, **cols)
+        buf = io.BytesIO()
+        np.savez(buf, meta=json.dumps(meta, default=_jsonable), **{a: getattr(self, a) for a in _ARRAYS}, **cols)
+        write_bytes(path, buf.getvalue())
 
     @classmethod
     def load(cls, path) -> "Solution":

@@ -15,7 +15,7 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 
-from odpipe.products.atomic import atomic_path
+from odpipe.products.atomic import save_figure
 
 from .ground import NAMES, fit_schedule, prepare
 from .report import plot_convergence, write_markdown, write_table
@@ -54,8 +54,7 @@ def plot_mesh(out: Path, df: pd.DataFrame, gaps) -> Path:
         fig.colorbar(im, ax=ax, shrink=0.85)
     fig.tight_layout()
     path = Path(out) / "mesh.png"
-    with atomic_path(path) as tmp:
-        fig.savefig(tmp, dpi=110, format="png")
+    save_figure(path, fig, dpi=110)
     plt.close(fig)
     return path
 

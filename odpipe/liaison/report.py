@@ -10,7 +10,7 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 
-from odpipe.products.atomic import atomic_path, write_text
+from odpipe.products.atomic import save_figure, write_csv, write_text
 
 
 def _cell(v) -> str:
@@ -31,8 +31,7 @@ def markdown_table(df: pd.DataFrame) -> str:
 
 def write_table(out: Path, name: str, df: pd.DataFrame) -> str:
     """Write NAME.csv and return the Markdown rendering."""
-    with atomic_path(Path(out) / f"{name}.csv") as tmp:
-        df.to_csv(tmp, index=False)
+    write_csv(Path(out) / f"{name}.csv", df, index=False)
     return markdown_table(df)
 
 
@@ -57,7 +56,7 @@ def plot_convergence(out: Path, name: str, panels: list[dict], ylabel: str, ncol
             ax.semilogy(p["t_days"] if "t" not in style else style["t"], y,
                         **{k: v for k, v in style.items() if k != "t"}, label=label)
         ax.set_title(p["title"], fontsize=9)
-        ax.set_xlabel("days")
+        ax.set_xlabel("time (days)")
         ax.grid(True, which="both", alpha=0.3)
     for row in axes:
         row[0].set_ylabel(ylabel)
@@ -66,7 +65,6 @@ def plot_convergence(out: Path, name: str, panels: list[dict], ylabel: str, ncol
         ax.set_visible(False)
     fig.tight_layout()
     path = Path(out) / f"{name}.png"
-    with atomic_path(path) as tmp:
-        fig.savefig(tmp, dpi=110, format="png")
+    save_figure(path, fig, dpi=110)
     plt.close(fig)
     return path

@@ -19,6 +19,8 @@ changes add up to the change over any compressed window. Columns added:
 - ``media_source`` / ``media_source_up``: which file and card (or model)
   gave the downlink / uplink values; ``media_note``: why a fallback was used.
 
+:func:`fallbacks` lists, per pass, the rows whose correction is a fallback or missing.
+
 The spacecraft direction comes from ``target_itrs(t_utc) -> (N, 3)`` m
 (apparent position seen from the ground at ground time), or from the
 table's ``elevation_rx``/``azimuth_rx`` columns (rad), interpolated in time
@@ -46,6 +48,8 @@ NOMINAL_HZ = {("up", "S"): 2.115e9, ("up", "X"): 7.16e9, ("up", "KA"): 34.3e9,
               ("down", "S"): 2.295e9, ("down", "X"): 8.42e9, ("down", "KA"): 32.05e9}
 TWO_LEG = ("range", "doppler_2way", "doppler_3way")
 GROUND = TWO_LEG + ("doppler_1way",)
+NOT_GROUND = "not a ground radiometric observable: no correction"
+NO_VALUE = "no correction computed"
 
 
 def calibrate(table: pd.DataFrame, model: MediaModel, *, target_itrs=None, ramps=None,
@@ -260,7 +264,7 @@ def _notes(n, rows, code, texts, ground, two_leg, rtlt_note):
     for k, (flag, _) in enumerate(reasons):
         hit = (np.char.find(texts, flag) >= 0)[code]
         np.bitwise_or.at(bits, rows[hit], 1 << k)
-    extra = [(two_leg, rtlt_note), (~ground, "not a ground radiometric observable: no correction")]
+    extra = [(two_leg, rtlt_note), (~ground, NOT_GROUND)]
     for k, (mask, _) in enumerate(extra, len(reasons)):
         bits |= np.where(mask, 1 << k, 0)
     words = [text for _, text in reasons] + [text for _, text in extra]
@@ -281,3 +285,24 @@ def pass_report(t: pd.DataFrame) -> pd.DataFrame:
         "sources": g["media_source"].agg(lambda x: " || ".join(sorted(set(x)))),
         "notes": g["media_note"].agg(lambda x: "; ".join(sorted({p for v in x for p in v.split("; ") if p}))),
     }).reset_index()
+
+
+def fallbacks(t: pd.DataFrame) -> pd.DataFrame:
+    """Per pass and reason, the rows of a calibrated table whose correction is a fallback or missing.
+
+    Reasons are the ``media_note`` parts, and ``NO_VALUE`` for a ground row left NaN without one;
+    rows that need no correction (not ground radiometric) are left out. Columns ``pass_id``,
+    ``station_rx``, ``observable``, ``start``, ``end`` (UTC of the pass), ``reason``, ``rows``
+    (rows of the pass with that reason) and ``of`` (rows of the pass).
+    """
+    note = t["media_note"].astype(str)
+    ground = ~note.str.contains(NOT_GROUND, regex=False)
+    reason = note.where((note != "") | t["media_m"].notna(), NO_VALUE)
+    g = t.groupby("pass_id", sort=True)
+    passes = pd.DataFrame({"station_rx": g["station_rx"].first(), "observable": g["observable"].first(),
+                           "start": g["epoch"].min(), "end": g["epoch"].max(), "of": g.size()})
+    rows = pd.DataFrame({"pass_id": t["pass_id"].to_numpy(), "reason": reason.to_numpy()})[ground.to_numpy()]
+    rows = rows[rows["reason"] != ""].assign(reason=lambda d: d["reason"].str.split("; ")).explode("reason")
+    counts = rows.groupby(["pass_id", "reason"], sort=True).size().rename("rows").reset_index()
+    out = counts.join(passes, on="pass_id")
+    return out[["pass_id", "station_rx", "observable", "start", "end", "reason", "rows", "of"]]

@@ -10,6 +10,8 @@ matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 import pandas as pd  # noqa: E402
 
+from odpipe.products.atomic import save_figure  # noqa: E402
+
 
 def plot_pass_delays(table: pd.DataFrame, pass_id: int, path) -> Path:
     """Troposphere, ionosphere and total correction (m) of one calibrated pass against UTC; returns the PNG path."""
@@ -30,6 +32,6 @@ def plot_pass_delays(table: pd.DataFrame, pass_id: int, path) -> Path:
         fig.text(0.01, 0.01, note, fontsize=7)
     fig.autofmt_xdate()
     path = Path(path)
-    fig.savefig(path, dpi=100)
+    save_figure(path, fig, dpi=100)
     plt.close(fig)
     return path

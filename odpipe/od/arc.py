@@ -21,7 +21,7 @@ import numpy as np
 import pandas as pd
 
 from odpipe.dynamics.forces import ForceModel, SolarRadiationPressure
-from odpipe.estimation.fit import EDIT_INNOVATION, FitOptions, Observations, Solution, build_grid, fit
+from odpipe.estimation.fit import EDIT_INNOVATION, NONFINITE, FitOptions, Observations, Solution, build_grid, fit
 from odpipe.estimation.maneuvers import maneuver_table
 from odpipe.estimation.registry import GaussMarkov, ParameterRegistry
 from odpipe.measurements import MeasurementSetup
@@ -206,8 +206,9 @@ def fit_arc(table: pd.DataFrame, setup: ArcSetup) -> ArcSolution:
     """Fit the arc; see :class:`ArcSetup` and :class:`ArcSolution`.
 
     Residual table columns: row (index in ``table``), epoch, observable, station_rx, pass_id,
-    time (TDB s), prefit/postfit (row units, last iteration), to_los (m or m/s per unit),
-    prefit_los/postfit_los, sigma (row units, after reweighting), flags (Flag.RESIDUAL when
+    time (TDB s), unit (the row's, when the table has one), apriori (observed - computed on the a
+    priori reference: the first iteration's pre-fit residual, row units), prefit/postfit (row units,
+    last iteration), to_los (m or m/s per unit), apriori_los/prefit_los/postfit_los, sigma (row units, after reweighting), flags (Flag.RESIDUAL when
     edited by the fit), status (why a row could not be computed; such rows are not fitted).
     """
     rows, times = select_rows(table, setup)
@@ -226,19 +227,20 @@ def fit_arc(table: pd.DataFrame, setup: ArcSetup) -> ArcSolution:
                                setup.start, setup.end, setup.lookback, epochs=grid)
 
     problem = problem_for(rows, times)
-    _, to_los, status = problem.reference(reg.apriori)
+    computed, to_los, status = problem.reference(reg.apriori)
     good = status == ""
     if not good.all():
         problem = problem_for(rows[good], times[good])
     used = rows[good]
-    sig = data_sigma(used, setup.data_sigma) / np.where(used["unit"] == "rad", 1.0, to_los[good])
+    # angle rows: sigma and value in rad; others along the line of sight (a sigma <= 0 is the config's, and edited)
+    sig = data_sigma(used, setup.data_sigma) / np.abs(np.where(used["unit"] == "rad", 1.0, to_los[good]))
     group = (used["observable"] + ":" + used["station_rx"].astype(str)).to_numpy(object)
     obs = Observations(times[good], used["value"].to_numpy(float), sig, group)
     x_ref = None
     for end in growing_ends(setup):  # unstable orbits: reach the full arc through shorter ones
         x_ref = fit(problem, obs, setup.start, end, replace(options, edit_k=(np.inf,)), x_ref=x_ref).x0
     sol = fit(problem, obs, setup.start, setup.end, options, x_ref=x_ref)
-    return _solution(setup, reg, problem, sol, rows, times, to_los, status)
+    return _solution(setup, reg, problem, sol, rows, times, to_los, status, rows["value"].to_numpy(float) - computed)
 
 
 def growing_ends(setup: ArcSetup) -> list[float]:
@@ -257,22 +259,29 @@ def growing_ends(setup: ArcSetup) -> list[float]:
     return ends
 
 
-def _solution(setup, reg, problem, sol, rows, times, to_los, status) -> ArcSolution:
+def _solution(setup, reg, problem, sol, rows, times, to_los, status, apriori) -> ArcSolution:
     st = reg.slice("state", setup.spacecraft)
     good = status == ""
     res = pd.DataFrame({"row": rows.index.to_numpy(), "epoch": rows["epoch"].to_numpy(),
                         "observable": rows["observable"].to_numpy(), "station_rx": rows["station_rx"].to_numpy(),
                         "pass_id": rows["pass_id"].to_numpy(), "time": times, "to_los": to_los,
                         "status": status})
+    if "unit" in rows:
+        res.insert(4, "unit", rows["unit"].astype(str).to_numpy())
+    res["apriori"] = np.where(good, apriori, np.nan)
     for col in ("prefit", "postfit", "sigma", "innovation", "innovation_sigma"):
         res[col] = np.nan
         res.loc[good, col] = sol.residuals[col].to_numpy()
+    res["apriori_los"] = res["apriori"] * res["to_los"]
     res["prefit_los"] = res["prefit"] * res["to_los"]
     res["postfit_los"] = res["postfit"] * res["to_los"]
     res["flags"] = 0
     edited = np.zeros(len(res), bool)
     edited[good] = (sol.residuals["flags"].to_numpy() & EDIT_INNOVATION) != 0
     res.loc[edited, "flags"] = int(Flag.RESIDUAL)
+    nonfinite = np.zeros(len(res), bool)
+    nonfinite[good] = (sol.residuals["flags"].to_numpy() & NONFINITE) != 0
+    res.loc[nonfinite, "flags"] |= int(Flag.NONFINITE)
     est = sol.parameters()
     params = pd.DataFrame({"name": reg.names, "kind": [p.kind for p in reg.parameters], "apriori": reg.apriori,
                            "estimate": est["estimate"].to_numpy(), "sigma": est["sigma"].to_numpy()})

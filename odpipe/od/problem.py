@@ -237,7 +237,8 @@ class TrackingProblem:
             return np.zeros(0), np.zeros(0), np.zeros(0, object), G_x, G_p, H_lin
         ev = compute(rows, trajs, self._measurement_setup(x0))
         res, _ = residuals(rows, ev)
-        value = rows["value"].to_numpy(float) - res          # computed, wrapped to the observation
+        observed = rows["value"].to_numpy(float)
+        value = np.where(np.isfinite(observed), observed - res, ev.value)  # computed, wrapped to the observation
         for sc in trajs:
             G_x[sc] = ev.partials.get(f"state:{sc}", np.zeros((m, 6)))
             G_p[sc] = ev.partials.get(f"dynamic:{sc}", np.zeros((m, len(trajs[sc].param_names))))

@@ -2,38 +2,111 @@
 
 Times are UTC ISO strings; relative paths resolve against the config's folder;
 units are SI (m, m/s, s, m²) unless a key says otherwise (``*_deg``).
-Unknown keys, wrong types and missing required keys are errors naming the key
-and the file (:class:`odpipe.runs.schema.ConfigError`).
+Unknown keys, wrong types, missing required keys and bad values (a time that
+does not exist, an end before the start, a sigma or step that is not positive
+and finite, a data file that is missing, unreadable or not recognised, a run
+name that would leave the output folder) are found at load, all of them at
+once: one :class:`odpipe.runs.schema.ConfigError` names the file and each key
+with its line.
 """
 
 from __future__ import annotations
 
-import tomllib
+import re
+import warnings
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Literal
 
-from odpipe.od.arc import sigma_value
-from odpipe.runs.schema import ConfigError, load
+import numpy as np
+
+from odpipe.runs.schema import (at_least, between, checked, file_name, internal, load, positive, read_toml,
+                                readable, readable_files)
+TRACKING_READERS = ("parsers.odf", "parsers.utdf", "parsers.trk234", "parsers.tdm")  # formats.READERS of tracking
+
+
+def utc_time(value: str) -> list[tuple[str, str]]:
+    """Check: a UTC ISO time (``YYYY-MM-DD[THH:MM:SS[.fff]]``) that exists."""
+    if not re.match(r"^\d{4}-\d{2}-\d{2}", value):
+        return [("", f"{value!r} is not a UTC ISO time (YYYY-MM-DDTHH:MM:SS)")]
+    try:
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore")  # a 'Z' suffix: numpy warns it drops the zone (UTC here anyway)
+            np.datetime64(value, "ns")
+    except ValueError as exc:
+        return [("", f"{value!r} is not a valid time: {str(exc).split(' in datetime string')[0].lower()}")]
+    return []
+
+
+def _utc(value: str) -> np.datetime64:
+    return np.datetime64(value.rstrip("Z"), "ns")
+
+
+def _recognised(path: Path, readers: tuple[str, ...], what: str) -> str | None:
+    """Why ``path`` is not a readable file that one of ``readers`` recognises (modules without a
+    ``sniff`` are taken on trust), or None."""
+    from parsers import formats  # pandas, only when a configuration is checked (not for `odpipe --help`)
+
+    why = readable(path)
+    if why:
+        return why
+    if path.suffix == ".parquet" and what == "tracking":
+        with open(path, "rb") as f:
+            return None if f.read(4) == b"PAR1" else f"{path} is not a Parquet file"
+    sniffing = [r for r in readers if r in formats.available()]
+    if len(sniffing) < len(readers):
+        return None
+    found = formats.detect(path)
+    if found in readers:
+        return None
+    return f"{path} is not a {what} file (" + (f"recognised as {found})" if found else
+                                                "no reader recognises it)")
+
+
+def _data_sigmas(value: dict) -> list[tuple[str, str]]:
+    """Check: each data_sigma entry a positive number, or for an angle observable a positive angle with its unit."""
+    from odpipe.od.arc import sigma_value  # the fit's own reading of the entries (imports numerics: only when checked)
+
+    out = []
+    for key, v in value.items():
+        try:
+            s = sigma_value(key, v)
+        except ValueError as exc:
+            out.append((f".{key}", str(exc)))
+            continue
+        if not (s > 0 and np.isfinite(s)):
+            out.append((f".{key}", "must be positive and finite"))
+    return out
+
+
+def _files_of(readers: tuple[str, ...], what: str):
+    """Check: a path (or every path of a list) is a readable file of one of ``readers``."""
+    return lambda paths: [("", why) for p in (paths if isinstance(paths, list) else [paths])
+                          if (why := _recognised(p, readers, what))]
 
 
 @dataclass
 class RunSection:
-    name: str
-    output: Path = Path("out")  # runs go to OUTPUT/NAME (attempt folders and 'current')
+    name: str = checked(file_name)  # one folder name: runs go to OUTPUT/NAME (attempt folders and 'current')
+    output: Path = Path("out")
 
 
 @dataclass
 class ArcSection:
     spacecraft: str  # id as the tracking files give it, e.g. "181"
-    start: str
-    end: str
+    start: str = checked(utc_time)
+    end: str = checked(utc_time)
+
+    def problems(self):
+        if _utc(self.end) <= _utc(self.start):
+            yield "end", f"{self.end} is not after the start {self.start}"
 
 
 @dataclass
 class DataSection:
-    files: list[Path]
-    stations: list[Path] = field(default_factory=list)  # station CSVs added to the default catalog
+    files: list[Path] = checked(_files_of(TRACKING_READERS, "tracking"))
+    # station CSVs added to the default catalog
+    stations: list[Path] = checked(readable_files, default_factory=list)
     # observables fitted; "observable:BAND" keeps only rows of that downlink band (e.g. "doppler_1way:X")
     observables: list[str] = field(default_factory=lambda: ["doppler_2way", "range"])
     errors: Literal["raise", "report"] = "report"  # nightly: report a corrupt record and go on
@@ -42,41 +115,41 @@ class DataSection:
 @dataclass
 class CalibrationSection:
     media: bool = True  # false: the table's values are already corrected (or simulated without media)
-    tro: list[Path] = field(default_factory=list)
-    ion: list[Path] = field(default_factory=list)
-    ionex: list[Path] = field(default_factory=list)
-    smoothing_order: int = 10  # per-pass polynomial; -1 = none
+    tro: list[Path] = checked(_files_of(("parsers.trk223",), "TRK-2-23"), default_factory=list)
+    ion: list[Path] = checked(_files_of(("parsers.trk223",), "TRK-2-23"), default_factory=list)
+    ionex: list[Path] = checked(_files_of(("parsers.ionex",), "IONEX"), default_factory=list)
+    smoothing_order: int = checked(at_least(-1), default=10)  # per-pass polynomial; -1 = none
 
 
 @dataclass
 class PreprocessSection:
-    count_time: float = 60.0  # s, Doppler compression target
+    count_time: float = checked(positive, default=60.0)  # s, Doppler compression target
     partial: Literal["keep", "flag", "drop"] = "keep"
-    elevation_mask_deg: float = 10.0
-    blunder_k: float = 10.0
-    min_pass_samples: int = 10
+    elevation_mask_deg: float = checked(between(-90.0, 90.0), default=10.0)
+    blunder_k: float = checked(positive, default=10.0)
+    min_pass_samples: int = checked(at_least(1), default=10)
 
 
 @dataclass
 class GravitySection:
     body: str
-    file: Path
-    degree: int
-    partial_degree: int | None = None
+    file: Path = checked(readable_files)
+    degree: int = checked(at_least(0))
+    partial_degree: int | None = checked(at_least(0), default=None)
 
 
 @dataclass
 class CylinderSection:
-    radius: float
-    length: float
-    rho_s: float = 0.0
-    rho_d: float = 0.0
+    radius: float = checked(positive)
+    length: float = checked(positive)
+    rho_s: float = checked(between(0.0, 1.0), default=0.0)
+    rho_d: float = checked(between(0.0, 1.0), default=0.0)
     axis: str | list[float] = "sun"  # spin axis: ICRF unit vector or 'sun'
 
 
 @dataclass
 class SrpSection:
-    cr_area: float = 0.0  # Cr·A, m² (cannonball)
+    cr_area: float = checked(at_least(0.0), default=0.0)  # Cr·A, m² (cannonball)
     cylinder: CylinderSection | None = None
     occulters: list[str] = field(default_factory=lambda: ["earth", "moon"])
 
@@ -88,7 +161,7 @@ class DynamicsSection:
     third_bodies: list[str] = field(default_factory=list)
     gravity: list[GravitySection] = field(default_factory=list)
     srp: SrpSection | None = None
-    mass: float = 1000.0  # kg
+    mass: float = checked(positive, default=1000.0)  # kg
     relativity: bool = False
 
 
@@ -96,45 +169,61 @@ class DynamicsSection:
 class InitialStateSection:
     """The a priori state at ``epoch``: given (``state``) or read from an OEM (``from_oem``), e.g. the
     previous arc's ``OUTPUT/NAME/current/trajectory.oem`` (a nightly chain; ``odpipe batch`` runs
-    that arc first)."""
+    that arc first, so the file need not exist when the configuration is loaded)."""
 
-    epoch: str  # UTC
+    epoch: str = checked(utc_time)  # UTC
     state: list[float] | None = None  # m, m/s, ICRF axes about dynamics.center
     from_oem: Path | None = None
+
+    def problems(self):
+        if (self.state is None) == (self.from_oem is None):
+            yield "", "give either state or from_oem"
+        elif self.state is not None and (len(self.state) != 6 or not np.all(np.isfinite(self.state))):
+            yield "state", "needs 6 finite numbers (m, m/s)"
 
 
 @dataclass
 class StochasticSection:
-    sigma: float  # m/s², steady state, per RTN axis
-    tau: float  # s (0 = white per batch)
-    batch: float  # s
+    sigma: float = checked(positive)  # m/s², steady state, per RTN axis
+    tau: float = checked(at_least(0.0))  # s (0 = white per batch)
+    batch: float = checked(positive)  # s
 
 
 @dataclass
 class EstimationSection:
-    sigma_position: float = 100e3
-    sigma_velocity: float = 1.0
-    srp_scale_sigma: float | None = 0.1
+    sigma_position: float = checked(positive, default=100e3)
+    sigma_velocity: float = checked(positive, default=1.0)
+    srp_scale_sigma: float | None = checked(positive, default=0.1)
     stochastic: StochasticSection | None = None
     # LOS sigma (m, m/s) by "observable" or "observable:station" (the station's entry wins); angle observables:
     # the angle's sigma, rad or with its unit ("0.01 deg", "36 arcsec")
-    data_sigma: dict[str, float | str] = field(default_factory=lambda: {"range": 2.0, "doppler_2way": 1e-4})
-    range_bias_sigma: float | None = 5.0
+    data_sigma: dict[str, float | str] = checked(lambda v: _data_sigmas(v),
+                                                 default_factory=lambda: {"range": 2.0, "doppler_2way": 1e-4})
+    range_bias_sigma: float | None = checked(positive, default=5.0)
     # one-way Doppler's oscillator, estimated when set: sigmas of its fractional frequency offset y0 and drift
     # y1 (1/s) about the arc start, one pair for every band it drives (a priori 0: the rows' reference)
-    oscillator_sigma: list[float] | None = None
-    maneuver_plan: Path | None = None  # planned maneuvers (parsers.maneuvers schema)
-    maneuver_epoch_sigma: float | None = None  # s: estimate planned burns' epochs (a plan's sigma_time wins)
-    edit_k: list[float] = field(default_factory=lambda: [float("inf"), 10.0, 5.0])
-    max_iter: int = 10
+    oscillator_sigma: list[float] | None = checked(positive, default=None)
+    # planned maneuvers (parsers.maneuvers schema)
+    maneuver_plan: Path | None = checked(_files_of(("parsers.maneuvers",), "maneuver plan"), default=None)
+    # s: estimate planned burns' epochs (a plan's sigma_time wins)
+    maneuver_epoch_sigma: float | None = checked(positive, default=None)
+    edit_k: list[float] = checked(lambda v: positive(v, allow_inf=True),
+                                  default_factory=lambda: [float("inf"), 10.0, 5.0])
+    max_iter: int = checked(at_least(1), default=10)
     reweight: bool = False  # ARTEMIS reweighting from post-fit RMS; see README (known instability)
     # data-weight stages multiplying every sigma, loose to tight (e.g. [30, 5, 1]): the next stage starts once
     # the epoch correction is below 1 sigma, so a far-off a priori is not fitted at full weight at once
-    sigma_scale: list[float] = field(default_factory=lambda: [1.0])
-    block: float = 600.0
+    sigma_scale: list[float] = checked(positive, default_factory=lambda: [1.0])
+    block: float = checked(positive, default=600.0)  # s, filter grid step
     # unlogged maneuvers: the filter's innovations are always tested (findings in the report); with a sigma
     # (m/s per axis) each finding also becomes an estimated impulsive maneuver and the arc is fitted again
-    detected_maneuver_sigma: float | None = None
+    detected_maneuver_sigma: float | None = checked(positive, default=None)
+
+    def problems(self):
+        if not self.sigma_scale:
+            yield "sigma_scale", "needs at least one stage"
+        if not self.edit_k:
+            yield "edit_k", "needs at least one value"
 
 
 @dataclass
@@ -143,7 +232,7 @@ class ProductsSection:
     spk: bool = True
     naif_id: int = -999
     object_name: str = ""
-    step: float = 60.0  # s between trajectory product states
+    step: float = checked(positive, default=60.0)  # s between trajectory product states
     plots: bool = True
 
 
@@ -158,32 +247,15 @@ class RunConfig:
     preprocess: PreprocessSection = field(default_factory=PreprocessSection)
     estimation: EstimationSection = field(default_factory=EstimationSection)
     products: ProductsSection = field(default_factory=ProductsSection)
-    path: Path | None = None
-    text: str = ""
+    path: Path | None = internal(None)  # the file read (set by load_config)
+    text: str = internal("")  # its text
 
 
 def load_config(path) -> RunConfig:
-    """Read and check a run configuration file."""
+    """Read and check a run configuration file: one ConfigError lists every problem (key and line)."""
     path = Path(path).resolve()
-    text = path.read_text()
-    try:
-        data = tomllib.loads(text)
-    except tomllib.TOMLDecodeError as exc:
-        raise ConfigError(path, "", f"not valid TOML: {exc}") from None
-    for reserved in ("path", "text"):
-        if reserved in data:
-            raise ConfigError(path, reserved, "unknown key")
-    cfg = load(RunConfig, data, path)
-    init = cfg.initial_state
-    if (init.state is None) == (init.from_oem is None):
-        raise ConfigError(path, "initial_state", "give either state or from_oem")
-    if init.state is not None and len(init.state) != 6:
-        raise ConfigError(path, "initial_state.state", "needs 6 numbers (m, m/s)")
-    for key, value in cfg.estimation.data_sigma.items():
-        try:
-            sigma_value(key, value)
-        except ValueError as exc:
-            raise ConfigError(path, f"estimation.data_sigma.{key}", str(exc)) from None
+    data, text = read_toml(path)
+    cfg = load(RunConfig, data, path, text=text)
     cfg.path, cfg.text = path, text
     return cfg
 

@@ -25,12 +25,12 @@ import numpy as np
 import pandas as pd
 
 from odpipe.analysis import maneuvers as maneuver_report
-from odpipe.analysis.overlap import consecutive_overlaps, oem_trajectory
+from odpipe.analysis import overlap
 from odpipe.pipeline.run import run_config
 from odpipe.products.atomic import write_text
 from odpipe.products.spk import SpkTrajectory
 from odpipe.runs.batch import night_summary, run_batch
-from odpipe.runs.report import Section, write_report
+from odpipe.runs.report import Section, utc_iso, write_report
 from odpipe.simulate.case import load as load_case
 from odpipe.simulate.run import run_case
 from odpipe.time import tdb_to_utc, utc_to_tdb
@@ -41,12 +41,6 @@ CASE = Path(__file__).resolve().parents[2] / "runs" / "artemis_p2_like.toml"
 HOUR = 3600.0
 J2000 = np.datetime64("2000-01-01T12:00:00", "ns")   # TDB epoch of the OEM time tags (TDB s past J2000)
 OFFSET = np.array([1000.0, -800.0, 600.0, 0.01, -0.01, 0.005])  # a priori displacement, m and m/s
-
-
-def _iso(t_tdb: float) -> str:
-    """UTC ISO string of a TDB epoch, to the nearest second."""
-    utc = np.asarray(tdb_to_utc(t_tdb)).astype("datetime64[ms]")
-    return str((utc + np.timedelta64(500, "ms")).astype("datetime64[s]"))
 
 
 def arcs(start: float, end: float, sk: list[float]) -> list[tuple[str, str, float, float]]:
@@ -91,8 +85,8 @@ name = "{name}"
 output = "../runs"
 [arc]
 spacecraft = "{case.spacecraft}"
-start = "{_iso(a)}"
-end = "{_iso(b)}"
+start = "{utc_iso(a)}"
+end = "{utc_iso(b)}"
 [data]
 files = {json.dumps(['../case/' + f for f in data])}
 stations = ["../case/stations.csv"]
@@ -112,7 +106,7 @@ rho_s = {float(body['rho_s'])}
 rho_d = {float(body['rho_d'])}
 axis = {list(map(float, body['spin_axis']))}
 [initial_state]
-epoch = "{_iso(a)}"
+epoch = "{utc_iso(a)}"
 state = {list(map(float, x0))}
 [estimation]
 stochastic = {{ sigma = {float(case.stochastic['sigma'])}, tau = {float(case.stochastic['tau_s'])}, batch = {float(case.stochastic['batch_s'])} }}
@@ -161,17 +155,23 @@ def run_demo(out: Path = Path("out/demo"), workers: int = 2, progress=print) -> 
     return _report(out, case, plan, files, truth)
 
 
+TRUTH_FORMATS = {"position error RMS (m)": "{:.3f}", "velocity error RMS (mm/s)": "{:.3f}",
+                 "max |error| (sigma)": "{:.2f}", "RMS error (sigma)": "{:.2f}", "within 3 sigma (%)": "{:.1f}",
+                 "fit time (s)": "{:.1f}"}
+
+
 def _report(out: Path, case, plan, files, truth) -> dict:
     runs = out / "runs"
     done = [(n, k, a, b) for n, k, a, b in plan if (runs / n / "current" / "trajectory.oem").exists()]
-    traj = {n: oem_trajectory(runs / n / "current" / "trajectory.oem") for n, *_ in done}
+    traj = {n: overlap.oem_trajectory(runs / n / "current" / "trajectory.oem") for n, *_ in done}
     sections, headline = [], {"case": case.name, "arcs fitted": f"{len(done)} of {len(plan)}"}
     for kind in ("short", "long"):
-        table, pngs = consecutive_overlaps(traj, [n for n, k, *_ in done if k == kind], out, kind,
+        table, pngs = overlap.consecutive_overlaps(traj, [n for n, k, *_ in done if k == kind], out, kind,
                                            f"{kind.capitalize()}-arc")
         if table is None:
             continue
-        sec = Section(f"{kind.capitalize()}-arc overlaps (RIC differences over each overlap)").table(table)
+        sec = Section(f"{kind.capitalize()}-arc overlaps (RIC differences over each overlap)").tables(
+            overlap.report_tables(table))
         for png in pngs:
             sec.figure(png, png.stem)
         sections.append(sec)
@@ -183,28 +183,30 @@ def _report(out: Path, case, plan, files, truth) -> dict:
         cur = runs / n / "current"
         err, z = truth_errors(cur / "trajectory.oem", truth, a, b)
         summary = json.loads((cur / "summary.json").read_text())
-        truth_rows.append({"arc": n, "kind": kind, "converged": summary["converged"],
+        truth_rows.append({"arc": n, "kind": kind, "start (UTC)": utc_iso(a), "end (UTC)": utc_iso(b),
+                           "converged": summary["converged"],
                            "position error RMS (m)": float(np.sqrt(np.mean(np.sum(err[:, :3] ** 2, 1)))),
                            "velocity error RMS (mm/s)": float(np.sqrt(np.mean(np.sum(err[:, 3:] ** 2, 1)))) * 1e3,
-                           "max |error|/sigma": float(np.max(np.abs(z))) if z.size else np.nan,
-                           "RMS error/sigma": float(np.sqrt(np.mean(z ** 2))) if z.size else np.nan,
-                           "share within 3 sigma": float(np.mean(np.abs(z) < 3)) if z.size else np.nan,
-                           "fit (s)": summary["fit_seconds"]})
+                           "max |error| (sigma)": float(np.max(np.abs(z))) if z.size else np.nan,
+                           "RMS error (sigma)": float(np.sqrt(np.mean(z ** 2))) if z.size else np.nan,
+                           "within 3 sigma (%)": 100 * float(np.mean(np.abs(z) < 3)) if z.size else np.nan,
+                           "fit time (s)": summary["fit_seconds"]})
     truth_table = pd.DataFrame(truth_rows)
     write_text(out / "truth_comparison.csv", truth_table.to_csv(index=False))
     sections.append(Section("Truth comparison (smoothed solution minus simulated truth)").text(
         "Errors every 30 min; error/sigma at the filter grid epochs with the reported smoothed covariance "
-        "(one hour clear of the arc ends).").table(truth_table))
-    headline["share of state errors within 3σ"] = f"{truth_table['share within 3 sigma'].mean():.3f}"
-    headline["RMS of state error/σ (1 if the covariance is realistic)"] = f"{truth_table['RMS error/sigma'].mean():.2f}"
+        "(one hour clear of the arc ends), in units of that sigma.").table(truth_table, TRUTH_FORMATS))
+    headline["share of state errors within 3σ"] = f"{truth_table['within 3 sigma (%)'].mean():.1f} %"
+    headline["RMS of state error/σ (1 if the covariance is realistic)"] = f"{truth_table['RMS error (sigma)'].mean():.2f}"
     mans = _maneuvers(out, done, files)
     if mans is not None:
-        rows, stats, vs_truth = mans
-        sections.append(Section("Maneuvers: designed − estimated (thesis Table 4.4)").table(rows).table(
-            stats.reset_index().rename(columns={"index": ""})))
-        sections.append(Section("Maneuvers: estimated − executed truth").table(vs_truth))
+        rows, stats, vs_truth, epochs = mans
+        sections.append(Section("Maneuvers: designed − estimated (thesis Table 4.4)").tables(
+            maneuver_report.report_tables(rows, stats, tdb_to_utc(epochs))))
+        sections.append(Section("Maneuvers: estimated − executed truth").table(
+            vs_truth, {"|executed| (mm/s)": "{:.3f}", "|error| (mm/s)": "{:.3f}", "max |error| (sigma)": "{:.2f}"}))
         headline["maneuver magnitude error vs truth (median)"] = f"{vs_truth['|error| (mm/s)'].median():.2f} mm/s"
-        headline["maneuver errors within 3σ"] = f"{(vs_truth['max |z|'] < 3).mean():.2f}"
+        headline["maneuver errors within 3σ"] = f"{(vs_truth['max |error| (sigma)'] < 3).mean():.2f}"
     report = write_report(out / "report.html", f"odpipe demo: {case.name}", headline, sections)
     headline["report"] = str(report)
     return headline
@@ -213,7 +215,7 @@ def _report(out: Path, case, plan, files, truth) -> dict:
 def truth_errors(oem_path: Path, truth, a: float, b: float) -> tuple[np.ndarray, np.ndarray]:
     """(errors every 30 min over [a, b], (N,6) m and m/s; errors over the reported sigmas (M,6) at the
     covariance epochs one hour clear of the arc ends and of maneuver epochs) of a fitted OEM against the truth."""
-    traj = oem_trajectory(oem_path)
+    traj = overlap.oem_trajectory(oem_path)
     t = np.arange(a, b, 1800.0)
     err = traj.state(t) - truth.state(t)
     z = []
@@ -247,6 +249,6 @@ def _maneuvers(out: Path, done, files):
     vs_truth = pd.DataFrame({"maneuver": table["maneuver"].to_numpy(), "arc": table["arc"].to_numpy(),
                              "|executed| (mm/s)": np.linalg.norm(ex, axis=1) * 1e3,
                              "|error| (mm/s)": np.linalg.norm(est - ex, axis=1) * 1e3,
-                             "max |z|": np.max(np.abs(est - ex) / sig, axis=1)})
+                             "max |error| (sigma)": np.max(np.abs(est - ex) / sig, axis=1)})
     write_text(out / "maneuvers_vs_truth.csv", vs_truth.to_csv(index=False))
-    return evaluated, stats, vs_truth
+    return evaluated, stats, vs_truth, table["epoch"].to_numpy(float)

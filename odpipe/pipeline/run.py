@@ -18,6 +18,7 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 
+from odpipe import __version__
 from odpipe.analysis import maneuvers as maneuver_report
 from odpipe.estimation.maneuvers import detect_maneuvers
 from odpipe.media.apply import calibrate
@@ -26,14 +27,14 @@ from odpipe.media.model import MediaModel
 from odpipe.od.arc import ManeuverPlan, fit_arc
 from odpipe.pipeline import setup as build
 from odpipe.pipeline.config import RunConfig, load_config
-from odpipe.pipeline.geometry import add_geometry
+from odpipe.pipeline.geometry import add_geometry, apparent_itrs, median_round_trip
 from odpipe.pipeline.ingest import ingest
 from odpipe.pipeline.products import fitted_segments
 from odpipe.preprocess.compress import compress
 from odpipe.preprocess.edit import EditConfig, edit
 from odpipe.preprocess.flags import summary as flag_summary
-from odpipe.products import residuals
-from odpipe.products.atomic import write_text
+from odpipe.products import parameters, residuals
+from odpipe.products.atomic import write_parquet, write_text
 from odpipe.products.oem import write_oem
 from odpipe.products.spk import write_spk
 from odpipe.runs import rundir
@@ -50,10 +51,10 @@ class RunLog:
     def __init__(self, progress):
         self.progress, self.lines, self.t0 = progress, [], time.perf_counter()
 
-    def __call__(self, line: str) -> None:
+    def __call__(self, line: str, terminal: bool = True) -> None:
         stamped = f"[{time.perf_counter() - self.t0:7.1f} s] {line}"
         self.lines.append(stamped)
-        if self.progress:
+        if self.progress and terminal:
             self.progress(stamped)
 
 
@@ -82,7 +83,7 @@ def run_config(path, *, force: bool = False, progress=print) -> dict:
     attempt = rundir.start(root)
     log = RunLog(progress)
     try:
-        summary = _run(cfg, attempt, log)
+        summary = _run(cfg, attempt, log, fingerprint)
         log(f"complete; products in {root / 'current'}")
         write_text(attempt.path / "run.log", "\n".join(log.lines) + "\n")
         attempt.finish(fingerprint, summary)
@@ -94,7 +95,7 @@ def run_config(path, *, force: bool = False, progress=print) -> dict:
         raise
 
 
-def _run(cfg: RunConfig, attempt, log: RunLog) -> dict:
+def _run(cfg: RunConfig, attempt, log: RunLog, fingerprint: dict) -> dict:
     data = ingest(cfg.data.files, cfg.data.errors)
     for line in data.log:
         log(line)
@@ -113,7 +114,8 @@ def _run(cfg: RunConfig, attempt, log: RunLog) -> dict:
     if cal.media:
         model = MediaModel(read_trk223(*cal.tro, *cal.ion) if (cal.tro or cal.ion) else None,
                            IonexModel(read_ionex(*cal.ionex)) if cal.ionex else None)
-        table, _ = calibrate(table, model, ramps=data.store, catalog=catalog,
+        table, _ = calibrate(table, model, target_itrs=apparent_itrs(apriori, fm.ephemeris), ramps=data.store,
+                             catalog=catalog,
                              order=None if cal.smoothing_order < 0 else cal.smoothing_order)
         log(f"calibrate: media on {int(np.isfinite(table['media_m']).sum())} rows; "
             f"sources {dict(table['media_source'].value_counts().head(4))}")
@@ -121,7 +123,7 @@ def _run(cfg: RunConfig, attempt, log: RunLog) -> dict:
         log("calibrate: media corrections off (calibration.media = false)")
 
     pre = cfg.preprocess
-    rtlt = float(np.nanmedian(table["rtlt_s"])) if np.isfinite(table["rtlt_s"]).any() else 0.0
+    rtlt = median_round_trip(table)
     n_raw = len(table)
     table, creport = compress(table, pre.count_time, ramps=data.ramps, partial=pre.partial, ramp_delay=rtlt)
     log(f"compress: {n_raw} rows -> {len(table)} at {pre.count_time:g} s count time")
@@ -143,7 +145,7 @@ def _run(cfg: RunConfig, attempt, log: RunLog) -> dict:
         log(f"refit with {len(added)} detected maneuver(s) estimated ({sigma} m/s per axis a priori)")
         arc = _fit(table, replace(setup, maneuvers=tuple(setup.maneuvers) + added), log)
     fit_seconds = time.perf_counter() - t0
-    return _products(cfg, attempt, log, table, arc, edits, fit_seconds, findings)
+    return _products(cfg, attempt, log, table, arc, edits, fit_seconds, findings, fingerprint)
 
 
 MAX_EPOCH_WINDOW_S = 600.0  # s: a burn found between rows closer than this also gets its epoch estimated
@@ -163,7 +165,7 @@ def _fit(table, setup, log):
     t0 = time.perf_counter()
     arc = fit_arc(table, setup)
     for h in arc.history:
-        log(f"fit iteration: {json.dumps(h, default=float)}")
+        log(f"fit iteration: {json.dumps(h, default=float)}", terminal=False)  # the fit logged it live
     log(f"fit: {'converged' if arc.converged else 'NOT converged'} in {len(arc.history)} iterations, "
         f"{time.perf_counter() - t0:.1f} s")
     return arc
@@ -186,15 +188,15 @@ def unlogged_maneuvers(res: pd.DataFrame, window: int = 20, p_false: float = 1e-
     return out
 
 
-def _products(cfg, attempt, log, table, arc, edits, fit_seconds, findings) -> dict:
+def _products(cfg, attempt, log, table, arc, edits, fit_seconds, findings, fingerprint) -> dict:
     res = arc.residuals
     stats = residuals.statistics(res)
-    table.to_parquet(attempt.product("tracking.parquet"))
-    res.to_parquet(attempt.product("residuals.parquet"))
+    write_parquet(attempt.product("tracking.parquet"), table)
+    write_parquet(attempt.product("residuals.parquet"), res)
     write_text(attempt.product("residual_statistics.csv"), stats.to_csv(index=False))
     per_pass = residuals.statistics(res, by=("station_rx", "observable", "pass_id"))
     write_text(attempt.product("residual_statistics_passes.csv"), per_pass.to_csv(index=False))
-    params = arc.parameters.copy()
+    params = parameters.with_units(arc.parameters)
     write_text(attempt.product("parameters.csv"), params.to_csv(index=False))
     man_rows = man_stats = None
     if len(arc.maneuvers):
@@ -205,25 +207,51 @@ def _products(cfg, attempt, log, table, arc, edits, fit_seconds, findings) -> di
     arc.solution.save(attempt.product("solution.npz"))
     segments = fitted_segments(arc, cfg.products.step)
     name = cfg.products.object_name or cfg.arc.spacecraft
+    prov = provenance(cfg, fingerprint, f"odpipe run {cfg.run.name}: smoothed solution")
     if cfg.products.oem:
-        write_oem(attempt.product("trajectory.oem"), segments, name, cfg.arc.spacecraft,
-                  comments=[f"odpipe run {cfg.run.name}: smoothed solution"])
+        write_oem(attempt.product("trajectory.oem"), segments, name, cfg.arc.spacecraft, comments=prov)
     if cfg.products.spk:
-        write_spk(attempt.product("trajectory.bsp"), segments, cfg.products.naif_id)
+        write_spk(attempt.product("trajectory.bsp"), segments, cfg.products.naif_id, comments=prov)
     figures = []
     if cfg.products.plots:
-        for which in ("prefit", "postfit"):
+        for which, caption in (("prefit", "pre-fit residuals against the a priori (first iteration)"),
+                               ("postfit", "post-fit residuals")):
             png = attempt.product(f"residuals_{which}.png")
-            residuals.plot(res, png, which, f"{cfg.run.name}: {which} residuals")
-            figures.append((png, f"{which} residuals along the line of sight"))
+            residuals.plot(res, png, which, f"{cfg.run.name}: {caption}")
+            figures.append((png, f"{caption}, along the line of sight"))
     summary = _summary(cfg, arc, stats, fit_seconds)
     write_text(attempt.product("summary.json"), json.dumps(summary, indent=1, default=float))
-    sections = [Section("Residuals").table(stats), Section("Residuals per pass").table(per_pass),
-                Section("Editing").table(edits)]
-    for png, caption in figures:
-        sections[0].figure(png, caption)
-    sections.append(Section("Estimated parameters").table(params))
     write_text(attempt.product("unlogged_maneuvers.csv"), findings.to_csv(index=False))
+    write_report(attempt.product("report.html"), f"odpipe run {cfg.run.name}", _headline(summary),
+                 _sections(cfg, res, stats, per_pass, edits, params, figures, findings, man_rows, man_stats,
+                           arc.maneuvers["epoch"].to_numpy(float) if len(arc.maneuvers) else None))
+    log(f"products: OEM/SPK ({sum(len(s.t_tdb) for s in segments)} states in {len(segments)} segments), "
+        "residuals, parameters, report.html")
+    return summary
+
+
+def provenance(cfg, fingerprint: dict, what: str) -> list[str]:
+    """Comment lines naming what made a product: odpipe's version (and its source hash), the config
+    (name, path, SHA-256) and the SHA-256 of every input file (``fingerprint``: :func:`rundir.fingerprint`)."""
+    lines = [what, f"software: odpipe {__version__} (source sha256 {fingerprint['software_sha256']})",
+             f"config: {cfg.run.name} {Path(cfg.path).resolve()} sha256 {fingerprint['config_sha256']}"]
+    return lines + [f"input: {Path(p).name} sha256 {h}" for p, h in fingerprint["inputs"].items()]
+
+
+def _sections(cfg, res, stats, per_pass, edits, params, figures, findings, man_rows, man_stats,
+              man_epochs) -> list[Section]:
+    resid = Section("Residuals per station").text(
+        "Along the line of sight: Doppler in mm/s, range in m; the pre-fit residuals are against the a priori "
+        "(the fit's first iteration), the post-fit against the smoothed solution; the last column is the "
+        "post-fit RMS in the observable's own unit.").tables(residuals.report_tables(stats))
+    for png, caption in figures:
+        resid.figure(png, caption)
+    sections = [resid, Section("Residuals per pass").tables(residuals.report_tables(per_pass)),
+                Section("Editing").text("Where every row went: the preprocessing editors (a row with two reasons "
+                                        "counts in both), then the fit; 'fitted' is the residual tables' used "
+                                        "rows.").table(residuals.edit_summary(edits, res)),
+                Section("Estimated parameters (epoch values; stochastic accelerations: first batch)").tables(
+                    parameters.report_tables(params))]
     detected = Section("Unlogged maneuvers (innovation test)")
     detected.text(f"{len(findings)} finding(s): runs of 20 normalized filter innovations beyond the chi-square "
                   "1e-6 quantile" + ("; each was estimated as an impulsive maneuver (see the parameters)"
@@ -231,14 +259,21 @@ def _products(cfg, attempt, log, table, arc, edits, fit_seconds, findings) -> di
                                      else ("; not estimated (estimation.detected_maneuver_sigma unset)"
                                            if len(findings) else ".")))
     if len(findings):
-        detected.table(findings[["after", "epoch", "statistic", "threshold"]])
+        detected.table(findings[["after", "epoch", "statistic", "threshold"]].rename(
+            columns={"after": "last quiet row (UTC)", "epoch": "first excess row (UTC)",
+                     "statistic": "window sum (chi-square)", "threshold": "threshold (chi-square)"}),
+            {"window sum (chi-square)": "{:.1f}", "threshold (chi-square)": "{:.1f}"})
     sections.append(detected)
     if man_stats is not None:
-        sections.append(Section("Maneuvers (designed − estimated)").table(man_rows).table(man_stats.reset_index()))
-    write_report(attempt.product("report.html"), f"odpipe run {cfg.run.name}", summary, sections)
-    log(f"products: OEM/SPK ({sum(len(s.t_tdb) for s in segments)} states in {len(segments)} segments), "
-        "residuals, parameters, report.html")
-    return summary
+        sections.append(Section("Maneuvers (designed − estimated)").tables(
+            maneuver_report.report_tables(man_rows, man_stats, tdb_to_utc(man_epochs))))
+    return sections
+
+
+def _headline(summary: dict) -> dict:
+    """The report's headline: the summary with its times and durations labelled."""
+    names = {"start": "start (UTC)", "end": "end (UTC)", "fit_seconds": "fit time (s)"}
+    return {names.get(k, k): v for k, v in summary.items()}
 
 
 def _summary(cfg, arc, stats, fit_seconds) -> dict:

@@ -18,6 +18,7 @@ Editors look only at columns, so they run on any TrackingTable:
 
 from __future__ import annotations
 
+import logging
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -28,6 +29,8 @@ from odpipe.preprocess.passes import LINK, assign_passes, link_id
 from odpipe.preprocess.ramp_segments import store
 from odpipe.preprocess.robust import gross, outliers, spikes
 from odpipe.preprocess.uplink import in_acquisition
+
+log = logging.getLogger(__name__)
 
 
 @dataclass
@@ -179,4 +182,17 @@ def edit(table: pd.DataFrame, ramps: pd.DataFrame | None = None, config: EditCon
         flags = set_flag(flags, outside_arc(out, *config.arc), Flag.OUTSIDE_ARC)
     flags = set_flag(flags, in_windows(out, config.windows), Flag.USER)
     out["flags"] = flags
+    _warn_unmasked(out, flags)
     return out, summary(flags)
+
+
+def _warn_unmasked(table: pd.DataFrame, flags: np.ndarray) -> None:
+    """Log the used station rows the elevation mask could not judge (no ``elevation_rx``)."""
+    used = (flags == 0) & (table["station_rx"].astype(str).to_numpy() != "")
+    if "elevation_rx" not in table:
+        if used.any():
+            log.warning("no elevation_rx column: the elevation mask was not applied to %d used rows", used.sum())
+        return
+    blind = used & ~np.isfinite(table["elevation_rx"].to_numpy(dtype=float))
+    if blind.any():
+        log.warning("%d used rows have no elevation_rx (NaN): not checked against the elevation mask", blind.sum())

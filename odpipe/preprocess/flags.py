@@ -10,13 +10,15 @@ import enum
 import numpy as np
 import pandas as pd
 
+from parsers import table as tt
+
 
 class Flag(enum.IntFlag):
     """One bit per edit reason."""
 
     ELEVATION = 1 << 0       # below the station elevation mask
-    DUPLICATE = 1 << 1       # same sample already present (first occurrence kept)
-    INVALID = 1 << 2         # the format itself marks the record invalid
+    DUPLICATE = tt.DUPLICATE  # same sample already present (first occurrence kept); readers set it too
+    INVALID = tt.INVALID      # the format marks the record invalid, or the value is not finite (set at read)
     BLUNDER = 1 << 3         # gross outlier of the detrended signal (median/MAD)
     AMBIGUITY = 1 << 4       # range outside its modulus or ambiguous against the model
     USER = 1 << 5            # analyst's edit window
@@ -25,6 +27,7 @@ class Flag(enum.IntFlag):
     RESIDUAL = 1 << 8        # residual outlier during the fit
     PARTIAL_COUNT = 1 << 9   # compressed sample shorter than the target count time
     UPLINK = 1 << 10         # transmitted during an uplink acquisition (retune, sweep): not on the ramp table
+    NONFINITE = 1 << 11      # value, sigma, computed value or partials NaN or infinite, or sigma <= 0
 
 
 def names(value: int) -> list[str]:

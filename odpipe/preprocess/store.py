@@ -1,16 +1,15 @@
 """TrackingTable files: Parquet, with the ramp table beside it in ``<name>.ramps.parquet``.
 
-Writes are atomic (temporary file in the same folder, then rename).
+Writes are atomic (:mod:`parsers.atomic`).
 """
 
 from __future__ import annotations
 
-import os
-import tempfile
 from pathlib import Path
 
 import pandas as pd
 
+from parsers.atomic import write_parquet
 from parsers.table import validate
 
 
@@ -20,26 +19,14 @@ def ramps_path(path) -> Path:
     return path.with_name(path.name.removesuffix(".parquet") + ".ramps.parquet")
 
 
-def _atomic_parquet(df: pd.DataFrame, path: Path) -> None:
-    fd, tmp = tempfile.mkstemp(dir=path.parent, prefix=f".{path.name}-")
-    os.close(fd)
-    try:
-        df.to_parquet(tmp, index=False)
-        os.chmod(tmp, 0o644)
-        os.replace(tmp, path)
-    except BaseException:
-        os.unlink(tmp)
-        raise
-
-
 def write(path, table: pd.DataFrame, ramps: pd.DataFrame | None = None) -> list[Path]:
     """Write the table (and its ramps, when any) atomically; returns the files written."""
     validate(table)
     path = Path(path)
-    _atomic_parquet(table.reset_index(drop=True), path)
+    write_parquet(path, table.reset_index(drop=True), index=False)
     written = [path]
     if ramps is not None and len(ramps):
-        _atomic_parquet(ramps.reset_index(drop=True), ramps_path(path))
+        write_parquet(ramps_path(path), ramps.reset_index(drop=True), index=False)
         written.append(ramps_path(path))
     return written
 

@@ -1,37 +1,11 @@
-"""Atomic writes: a product appears whole or not at all.
+"""Atomic writes for the pipeline's products, tables, plots and reports.
 
-A file is written to a temporary name in the destination folder and renamed
-over the destination only when complete, so a killed run never leaves a
-partial product where a good one stood.
+The implementation is :mod:`parsers.atomic` (temporary file in the same folder,
+fsync, rename, fsync of the folder), the project's one home for it: the format
+writers of ``parsers`` use it too, and ``parsers`` may not import ``odpipe``.
 """
 
-from __future__ import annotations
+from parsers.atomic import (atomic_path, fsync_dir, save_figure, write_bytes, write_csv, write_parquet,
+                            write_text)
 
-import os
-import tempfile
-from contextlib import contextmanager
-from pathlib import Path
-
-
-@contextmanager
-def atomic_path(path):
-    """Yield a temporary path beside ``path``; rename it to ``path`` if the block succeeds."""
-    path = Path(path)
-    path.parent.mkdir(parents=True, exist_ok=True)
-    fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.", suffix=".part", dir=path.parent)
-    os.close(fd)
-    os.unlink(tmp)  # writers such as SPICE refuse to open an existing file
-    tmp = Path(tmp)
-    try:
-        yield tmp
-        os.replace(tmp, path)
-    finally:
-        if tmp.exists():
-            tmp.unlink()
-
-
-def write_text(path, text: str) -> Path:
-    """Write ``text`` to ``path`` atomically; returns the path."""
-    with atomic_path(path) as tmp:
-        tmp.write_text(text)
-    return Path(path)
+__all__ = ["atomic_path", "fsync_dir", "save_figure", "write_bytes", "write_csv", "write_parquet", "write_text"]

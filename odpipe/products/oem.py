@@ -20,7 +20,8 @@ _TRIL = np.tril_indices(6)
 
 
 def epoch_strings(t_tdb, time_system: str = "TDB") -> list[str]:
-    """ISO calendar strings (µs) of TDB seconds past J2000, in TDB or UTC."""
+    """ISO calendar strings of TDB seconds past J2000, in TDB or UTC, rounded to the nearest µs (an
+    epoch on a whole µs reads back as the same double: see :func:`odpipe.pipeline.products.fitted_segments`)."""
     t_tdb = np.atleast_1d(np.asarray(t_tdb, dtype=float))
     if time_system == "TDB":
         # The TDB calendar has no leap seconds: plain arithmetic from J2000.
@@ -31,24 +32,26 @@ def epoch_strings(t_tdb, time_system: str = "TDB") -> list[str]:
         epochs = np.asarray(tdb_to_utc(t_tdb), dtype="datetime64[ns]")
     else:
         raise ValueError(f"OEM time system must be TDB or UTC, not {time_system!r}")
-    return [str(e) for e in epochs.astype("datetime64[us]")]
+    ns = epochs.astype("datetime64[ns]").astype(np.int64)
+    return [str(e) for e in ((ns + 500) // 1000).astype("datetime64[us]")]
 
 
 def format_oem(segments: list[EphemerisSegment], object_name: str, object_id: str, *,
                time_system: str = "TDB", originator: str = "odpipe", interpolation_degree: int = 7,
                comments: list[str] = (), creation_date: str | None = None) -> str:
-    """The text of an OEM with one data block (and covariance block) per segment.
+    """The text of an OEM with one data block (and covariance block) per segment; ``comments`` (e.g.
+    the run's provenance) become COMMENT lines of the header.
 
     ``creation_date`` (ISO, UTC) defaults to now; give one for byte-reproducible files."""
     created = creation_date or datetime.now(timezone.utc).strftime("%Y-%m-%dT%H:%M:%S")
-    out = ["CCSDS_OEM_VERS = 2.0", f"CREATION_DATE = {created}", f"ORIGINATOR = {originator}", ""]
+    out = ["CCSDS_OEM_VERS = 2.0", *[f"COMMENT {c}" for c in comments], f"CREATION_DATE = {created}",
+           f"ORIGINATOR = {originator}", ""]
     for seg in segments:
         epochs = epoch_strings(seg.t_tdb, time_system)
         out += ["META_START", f"OBJECT_NAME = {object_name}", f"OBJECT_ID = {object_id}",
                 f"CENTER_NAME = {seg.center.upper()}", "REF_FRAME = ICRF", f"TIME_SYSTEM = {time_system}",
                 f"START_TIME = {epochs[0]}", f"STOP_TIME = {epochs[-1]}", "INTERPOLATION = HERMITE",
                 f"INTERPOLATION_DEGREE = {interpolation_degree}", "META_STOP", ""]
-        out += [f"COMMENT {c}" for c in comments]
         km = seg.states / 1e3
         out += [f"{e} " + " ".join(f"{v: .16e}" for v in row) for e, row in zip(epochs, km)]
         out.append("")

@@ -19,11 +19,14 @@ NAIF_IDS = {"ssb": 0, "sun": 10, "mercury": 199, "venus": 299, "earth": 399, "mo
 
 
 def write_spk(path, segments: list[EphemerisSegment], body_id: int, *, degree: int = 7,
-              segment_id: str = "odpipe") -> None:
+              segment_id: str = "odpipe", comments: list[str] = ()) -> None:
     """Write segments of body ``body_id`` (a NAIF id, e.g. -181) to a new SPK, atomically.
 
-    ``degree`` is the Hermite polynomial degree (odd, 1..27); SPICE uses
-    (degree+1)/2 states per interpolation window.
+    Each segment covers exactly its first to its last epoch. ``degree`` is the
+    Hermite polynomial degree (odd, 1..27); SPICE uses (degree+1)/2 states per
+    interpolation window. ``comments`` (e.g. the run's provenance) go into the
+    file's comment area (lines of at most 1000 characters; read with ``commnt``
+    or ``spiceypy.dafec``).
     """
     if degree % 2 == 0:
         raise ValueError("SPK type 13 needs an odd Hermite degree")
@@ -31,9 +34,14 @@ def write_spk(path, segments: list[EphemerisSegment], body_id: int, *, degree: i
     unknown = [seg.center for seg, c in zip(segments, centers) if c is None]
     if unknown:
         raise ValueError(f"no NAIF id known for centre(s) {unknown}")
+    comments = [str(c) for c in comments]
+    if any(len(c) > 1000 for c in comments):
+        raise ValueError("SPK comment lines are limited to 1000 characters")
     with atomic_path(path) as tmp:
-        handle = sp.spkopn(str(tmp), "odpipe", 0)
+        handle = sp.spkopn(str(tmp), "odpipe", sum(len(c) + 1 for c in comments))
         try:
+            if comments:
+                sp.dafac(handle, comments)
             for seg, center in zip(segments, centers):
                 sp.spkw13(handle, body_id, center, "J2000", float(seg.t_tdb[0]), float(seg.t_tdb[-1]),
                           segment_id[:40], degree, len(seg.t_tdb), np.ascontiguousarray(seg.states / 1e3),

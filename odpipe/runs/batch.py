@@ -6,16 +6,50 @@ products are complete and whose config and inputs are unchanged is skipped
 by ``run_one`` itself (see :func:`odpipe.runs.rundir.up_to_date`), so a
 batch killed at any point is simply started again. An arc that starts from another
 arc's products (a nightly chain) runs after it, and is reported failed without being
-run when that arc failed.
+run when that arc failed. An arc whose configuration cannot be loaded is reported
+failed (``failed=``) and the rest run.
+
+The batch configuration (``[batch]`` table) is :class:`BatchSection`.
 """
 
 from __future__ import annotations
 
+import logging
 import time
-import traceback
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Callable
+
+from odpipe.errors import describe
+from odpipe.runs.schema import checked, load, positive, read_toml
+
+_log = logging.getLogger(__name__)
+
+
+@dataclass
+class BatchSection:
+    """``[batch]`` of a nightly batch configuration; globs and paths relative to its folder, or absolute."""
+
+    arcs: list[Path]  # run configurations (globs allowed); a listed file that is absent fails as its arc
+    workers: int = checked(positive, default=2)  # local Dask cluster size
+    report: Path | None = None  # folder of the night's report (residual statistics, overlaps)
+    overlaps: list[Path] | None = None  # arcs whose consecutive overlaps are reported (default: all)
+
+    def problems(self):
+        if not self.arcs:
+            yield "arcs", "lists no run configuration"
+
+
+@dataclass
+class BatchConfig:
+    batch: BatchSection
+
+
+def load_batch(path) -> BatchSection:
+    """The ``[batch]`` table of the batch configuration file ``path``, checked (ConfigError)."""
+    path = Path(path).resolve()
+    data, text = read_toml(path)
+    return load(BatchConfig, data, path, text=text).batch
 
 
 @dataclass
@@ -37,7 +71,7 @@ def _guarded(run_one: Callable[[Path], dict], config: str, *after: ArcOutcome) -
         return ArcOutcome(config, detail.get("status", "complete"), time.perf_counter() - t0, detail)
     except Exception as exc:  # one arc's failure is reported, never fatal to the batch
         return ArcOutcome(config, "failed", time.perf_counter() - t0,
-                          error="".join(traceback.format_exception_only(exc)).strip())
+                          error=describe(exc, hint=f"`odpipe --debug run {config}` shows the traceback")[1])
 
 
 def dependency_order(configs: list[str], after: dict) -> list[str]:
@@ -61,31 +95,39 @@ def dependency_order(configs: list[str], after: dict) -> list[str]:
 
 
 def run_batch(configs, run_one: Callable[[Path], dict], *, after: dict | None = None, scheduler: str | None = None,
-              workers: int = 2, progress: Callable[[str], None] = print) -> list[ArcOutcome]:
+              workers: int = 2, progress: Callable[[str], None] = _log.info,
+              failed: dict | None = None) -> list[ArcOutcome]:
     """Run every arc config; returns one outcome per arc in completion order.
 
     ``after``: config -> configs whose products it starts from (run first). ``scheduler``
     is the address of a running Dask scheduler; without it a local cluster of ``workers``
-    single-threaded processes is started.
+    single-threaded processes is started. ``failed``: config -> why it cannot run (e.g. its
+    configuration does not load): reported failed first, with the arcs that start from it.
     """
     from distributed import Client, LocalCluster, as_completed
 
     after = {str(c): [str(d) for d in ds] for c, ds in (after or {}).items()}
-    configs = dependency_order([str(c) for c in configs], after)
+    broken = {str(c): ArcOutcome(str(c), "failed", 0.0, error=why) for c, why in (failed or {}).items()}
+    total = len({str(c) for c in configs} | set(broken))
+    outcomes: list[ArcOutcome] = []
+    for out in broken.values():
+        outcomes.append(out)
+        progress(f"[{len(outcomes)}/{total}] {Path(out.config).name}: failed: {out.error}")
+    configs = [c for c in dependency_order([str(c) for c in configs], after) if c not in broken]
+    if not configs:
+        return outcomes
     cluster = None if scheduler else LocalCluster(n_workers=workers, threads_per_worker=1,
                                                   processes=True, dashboard_address=":0")  # any free port: never clash with a running cluster
-    outcomes: list[ArcOutcome] = []
     with Client(scheduler or cluster) as client:
         futures = {}
         for i, c in enumerate(configs):
-            futures[c] = client.submit(_guarded, run_one, c, *[futures[d] for d in after.get(c, ())],
-                                       key=f"arc-{i}", pure=False)
-        futures = list(futures.values())
-        for k, fut in enumerate(as_completed(futures), start=1):
+            deps = [broken[d] if d in broken else futures[d] for d in after.get(c, ()) if d in broken or d in futures]
+            futures[c] = client.submit(_guarded, run_one, c, *deps, key=f"arc-{i}", pure=False)
+        for fut in as_completed(list(futures.values())):
             out = fut.result()
             outcomes.append(out)
             note = f": {out.error}" if out.error else ""
-            progress(f"[{k}/{len(configs)}] {Path(out.config).name}: {out.status} in {out.seconds:.1f} s{note}")
+            progress(f"[{len(outcomes)}/{total}] {Path(out.config).name}: {out.status} in {out.seconds:.1f} s{note}")
     if cluster is not None:
         cluster.close()
     return outcomes

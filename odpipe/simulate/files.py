@@ -16,12 +16,12 @@ Encodings (what the project's readers decode back):
 
 from __future__ import annotations
 
-import shutil
 from pathlib import Path
 
 import numpy as np
 import pandas as pd
 
+from odpipe.products.atomic import write_bytes, write_parquet, write_text
 from odpipe.products.ephemeris import EphemerisSegment
 from odpipe.products.oem import write_oem
 from odpipe.products.spk import write_spk
@@ -170,20 +170,20 @@ def write_case(out: Path, case, truth, obs, calibrations: dict, setup, stations_
     paths["tdm"] = out / f"{case.name}.tdm"
     tdm.write(paths["tdm"], tdm_data(t, obs.errors["to_los"].to_numpy(), case.start))
     paths["table"] = out / "tracking.parquet"
-    t.to_parquet(paths["table"])
+    write_parquet(paths["table"], t)
     paths["ramps"] = out / "ramps.parquet"
-    ramps.to_parquet(paths["ramps"])
+    write_parquet(paths["ramps"], ramps)
     paths["errors"] = out / "simulated_errors.parquet"
-    obs.errors.to_parquet(paths["errors"])
+    write_parquet(paths["errors"], obs.errors)
     for kind, text in calibrations.items():
         paths[kind] = out / f"{case.name}.{kind.upper()}"
-        paths[kind].write_text(text)
+        write_text(paths[kind], text)
     paths["maneuvers"] = out / "maneuvers_designed.csv"
     write_plan(maneuver_plan(truth.maneuvers), paths["maneuvers"])
     paths["maneuvers_executed"] = out / "maneuvers_executed_truth.csv"
     write_plan(maneuver_plan(truth.maneuvers, truth.executed), paths["maneuvers_executed"])
     paths["stations"] = out / "stations.csv"
-    shutil.copyfile(stations_csv, paths["stations"])
+    write_bytes(paths["stations"], Path(stations_csv).read_bytes())
     seg = _segments(truth.trajectory, truth.epochs, step_s)
     paths["spk"] = out / f"{case.name}_truth.bsp"
     write_spk(paths["spk"], seg, case.naif_id)

@@ -5,17 +5,17 @@
 segment's metadata, which ``write`` uses to turn a TrackingData back into a TDM in either
 syntax. Malformed files raise :class:`parsers.ParseError` naming file, line and keyword;
 with ``errors="report"`` bad data lines are reported and skipped (metadata faults always
-raise). XML DOCTYPE/ENTITY declarations are refused.
+raise). Values that are not finite (NaN, inf) are kept with the INVALID flag. XML
+DOCTYPE/ENTITY declarations are refused; KVN must be UTF-8.
 """
 
 from __future__ import annotations
 
 import gc
-import os
-import tempfile
 from pathlib import Path
 
-from parsers.errors import ParseReport
+from parsers.atomic import write_text
+from parsers.errors import ParseReport, check_mode, decode
 from parsers.table import TrackingData
 from parsers.tdm import keywords, kvn, times, xml
 from parsers.tdm.message import Message, Segment
@@ -32,17 +32,18 @@ def sniff(head: bytes) -> bool:
 
 def read(path, errors: str = "raise") -> TrackingData:
     """Read a KVN or XML TDM."""
+    check_mode(errors)
     path = Path(path)
     raw = path.read_bytes()
+    report = ParseReport()
     is_xml = raw.lstrip(b"\xef\xbb\xbf \t\r\n").startswith(b"<")
     collecting = gc.isenabled()
     gc.disable()  # millions of small objects, no cycles: the cyclic collector only costs time here
     try:
-        msg = xml.parse(raw, path) if is_xml else kvn.parse(raw.decode("utf-8", errors="replace"), path)
+        msg = xml.parse(raw, path, errors, report) if is_xml else kvn.parse(decode(raw, path), path, errors, report)
     finally:
         if collecting:
             gc.enable()
-    report = ParseReport()
     table, ramps = tracking(msg, path.name, path, errors, report)
     templates = [Segment(meta=s.meta, meta_comments=s.meta_comments, data_comments=s.data_comments)
                  for s in msg.segments]
@@ -55,13 +56,4 @@ def write(path, data: TrackingData, syntax: str = "kvn") -> None:
     """Write ``data`` (as read by :func:`read`) as a TDM in ``syntax`` "kvn" or "xml", atomically."""
     msg: Message = message(data.table, data.meta)
     text = {"kvn": kvn.render, "xml": xml.render}[syntax](msg)
-    folder = os.path.dirname(os.path.abspath(path))
-    fd, tmp = tempfile.mkstemp(dir=folder, prefix=".tdm-")
-    try:
-        with os.fdopen(fd, "w", encoding="utf-8") as f:
-            f.write(text)
-        os.chmod(tmp, 0o644)
-        os.replace(tmp, path)
-    except BaseException:
-        os.unlink(tmp)
-        raise
+    write_text(path, text)

@@ -2,15 +2,18 @@
 
 from __future__ import annotations
 
-from parsers.errors import ParseError
+from parsers.errors import ParseError, ParseReport, handle
 from parsers.tdm.message import (Message, Segment, check_data_keyword, check_header, check_meta,
                                  close_meta)
 
 _BLOCKS = {"META_START": "meta", "DATA_START": "data"}
 
 
-def parse(text: str, path) -> Message:
-    """The :class:`Message` in KVN ``text``; ParseError on the first malformed line."""
+def parse(text: str, path, errors: str = "raise", report: ParseReport | None = None) -> Message:
+    """The :class:`Message` in KVN ``text``; ParseError on the first malformed line.
+
+    With ``errors="report"`` a malformed data line is reported and skipped; other faults raise.
+    """
     msg = Message()
     state, seg, line_no = "version", None, 0
     for line_no, raw in enumerate(text.splitlines(), start=1):
@@ -49,28 +52,38 @@ def parse(text: str, path) -> Message:
         if line == "DATA_STOP" and state == "data":
             state = "between"
             continue
+        if state == "data":
+            try:
+                _data_line(path, seg, key, eq, rest, line_no)
+            except ParseError as err:
+                handle(err, errors, report)
+            continue
         if not eq:
-            raise ParseError(path, f"expected KEYWORD = value, got {line!r}", line=line_no, record=key)
+            raise ParseError(path, f"expected KEYWORD = value, got {line[:60]!r}", line=line_no, record=key[:40])
         if state == "header":
             check_header(path, key, rest, line_no)
             msg.header[key] = rest
         elif state == "meta":
             check_meta(path, key, rest, line_no)
             seg.meta[key] = rest
-        elif state == "data":
-            check_data_keyword(path, key, line_no)
-            fields = rest.split()
-            if len(fields) != 2:
-                raise ParseError(path, f"{key} needs an epoch and one value, got {rest!r}", line=line_no, record=key)
-            seg.keyword.append(key)
-            seg.epoch.append(fields[0])
-            seg.value.append(fields[1])
-            seg.line.append(line_no)
         else:
             raise ParseError(path, f"{key} outside any block", line=line_no, record=key)
     if state not in ("between",) or not msg.segments:
         raise ParseError(path, f"file ends inside {state} (no complete META/DATA segment)", line=line_no)
     return msg
+
+
+def _data_line(path, seg: Segment, key: str, eq: str, rest: str, line_no: int) -> None:
+    if not eq:
+        raise ParseError(path, f"expected KEYWORD = epoch value, got {key[:60]!r}", line=line_no, record=key[:40])
+    check_data_keyword(path, key, line_no)
+    fields = rest.split()
+    if len(fields) != 2:
+        raise ParseError(path, f"{key} needs an epoch and one value, got {rest[:60]!r}", line=line_no, record=key)
+    seg.keyword.append(key)
+    seg.epoch.append(fields[0])
+    seg.value.append(fields[1])
+    seg.line.append(line_no)
 
 
 def render(msg: Message) -> str:

@@ -10,7 +10,7 @@ from __future__ import annotations
 import re
 from dataclasses import dataclass, field
 
-from parsers.errors import ParseError
+from parsers.errors import ParseError, finite
 from parsers.tdm import keywords as kw
 from parsers.tdm import times
 
@@ -53,10 +53,7 @@ def check_meta(path, key: str, value: str, line: int) -> None:
     if key not in kw.METADATA:
         raise ParseError(path, f"unexpected metadata keyword {key}", line=line, record=key)
     if key in kw.NUMBER:
-        try:
-            float(value)
-        except ValueError:
-            raise ParseError(path, f"{key} = {value!r} is not a number", line=line, record=key) from None
+        finite(value, path, key, line=line, record=key)
     elif key in kw.TIME and not _EPOCH.match(value):
         raise ParseError(path, f"{key} = {value!r} is not a CCSDS epoch", line=line, record=key)
     elif key in kw.PATH and not _PATH.match(value):

@@ -9,7 +9,7 @@ from __future__ import annotations
 from xml.parsers import expat
 from xml.sax.saxutils import escape, quoteattr
 
-from parsers.errors import ParseError
+from parsers.errors import ParseError, ParseReport, handle
 from parsers.tdm.message import (Message, Segment, check_data_keyword, check_header, check_meta,
                                  close_meta)
 
@@ -62,8 +62,11 @@ def _value(node: _Node) -> str:
     return "".join(node.text).strip()
 
 
-def parse(data: bytes, path) -> Message:
-    """The :class:`Message` in XML ``data``; ParseError on the first malformed element."""
+def parse(data: bytes, path, errors: str = "raise", report: ParseReport | None = None) -> Message:
+    """The :class:`Message` in XML ``data``; ParseError on the first malformed element.
+
+    With ``errors="report"`` a malformed ``<observation>`` is reported and skipped; other faults raise.
+    """
     root = _tree(data, path)
     if root.tag != "tdm":
         raise ParseError(path, f"root element is <{root.tag}>, not <tdm>", line=root.line, record=root.tag)
@@ -80,7 +83,7 @@ def parse(data: bytes, path) -> Message:
             for s in part.children:
                 if s.tag != "segment":
                     raise ParseError(path, f"unexpected <{s.tag}> in body", line=s.line, record=s.tag)
-                msg.segments.append(_segment(s, path))
+                msg.segments.append(_segment(s, path, errors, report))
         else:
             raise ParseError(path, f"unexpected <{part.tag}> in tdm", line=part.line, record=part.tag)
     if not msg.segments:
@@ -88,7 +91,7 @@ def parse(data: bytes, path) -> Message:
     return msg
 
 
-def _segment(node: _Node, path) -> Segment:
+def _segment(node: _Node, path, errors, report) -> Segment:
     seg = Segment()
     for block in node.children:
         if block.tag == "metadata":
@@ -104,7 +107,10 @@ def _segment(node: _Node, path) -> Segment:
                 if obs.tag == "COMMENT":
                     seg.data_comments.append(_value(obs))
                     continue
-                _observation(obs, seg, path)
+                try:
+                    _observation(obs, seg, path)
+                except ParseError as err:
+                    handle(err, errors, report)
         else:
             raise ParseError(path, f"unexpected <{block.tag}> in segment", line=block.line, record=block.tag)
     return seg

@@ -4,7 +4,9 @@
 TrackingTable (see :mod:`parsers.trk234.observables`), the uplink ramps (format 9) as a
 ramp table, and in ``meta["blocks"]`` every SFDU with all its fields (one
 :class:`Block` of packed records per format code), which :func:`write` turns back into the
-same bytes. :func:`new_block` makes SFDUs from scratch.
+same bytes. :func:`new_block` makes SFDUs from scratch. A duplicated record's rows are kept
+with the DUPLICATE flag, rows without a finite value with INVALID (:mod:`parsers.table`);
+an empty file is a ParseError in both modes.
 """
 
 from __future__ import annotations
@@ -13,7 +15,8 @@ from pathlib import Path
 
 import numpy as np
 
-from parsers.errors import ParseReport
+from parsers import table as tt
+from parsers.errors import ParseError, ParseReport, check_mode
 from parsers.table import TrackingData
 from parsers.trk234 import layout
 from parsers.trk234.observables import ramp_table, tracking_table
@@ -30,15 +33,19 @@ def sniff(head: bytes) -> bool:
 
 def read(path, errors: str = "raise") -> TrackingData:
     """Read a TRK-2-34 file; ``errors="report"`` skips corrupt SFDUs into ``report``."""
+    check_mode(errors)
     path = Path(path)
     report = ParseReport()
-    blocks = split(path.read_bytes(), path, errors, report)
+    buf = path.read_bytes()
+    if not buf:
+        raise ParseError(path, "empty file", offset=0)
+    blocks = split(buf, path, errors, report)
     counts = {b.format_code: 0 for b in blocks}
     for b in blocks:
         counts[b.format_code] += len(b.records)
     spacecraft = sorted({int(s) for b in blocks for s in np.unique(b.records["scft_id"])})
     meta = {"format": "TRK-2-34", "sfdu_counts": counts, "spacecraft": spacecraft, "blocks": blocks}
-    table, ramps = tracking_table(blocks, path.name), ramp_table(blocks, path.name)
+    table, ramps = tt.flag_duplicates(tracking_table(blocks, path.name)), ramp_table(blocks, path.name)
     return TrackingData(mark_ramped(table, ramps), ramps, report, meta)
 
 

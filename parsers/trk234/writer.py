@@ -2,11 +2,9 @@
 
 from __future__ import annotations
 
-import os
-import tempfile
-
 import numpy as np
 
+from parsers.atomic import write_bytes
 from parsers.table import TrackingData
 from parsers.trk234 import layout
 from parsers.trk234.sfdu import Block, join
@@ -50,13 +48,4 @@ def new_block(format_code: int, n: int, n_obs: int = 0, index=None, **fields) ->
 def write(path, blocks: list[Block] | TrackingData) -> None:
     """Write ``blocks`` (or a TrackingData's ``meta["blocks"]``) as one TRK-2-34 file, SFDUs in ``index`` order."""
     data = join(blocks.meta["blocks"] if isinstance(blocks, TrackingData) else blocks)
-    folder = os.path.dirname(os.path.abspath(path))
-    fd, tmp = tempfile.mkstemp(dir=folder, prefix=".trk234-")
-    try:
-        with os.fdopen(fd, "wb") as f:
-            f.write(data)
-        os.chmod(tmp, 0o644)
-        os.replace(tmp, path)
-    except BaseException:
-        os.unlink(tmp)
-        raise
+    write_bytes(path, data)

@@ -1,0 +1,19 @@
+"""The nightly batch under SIGKILL: the short version of ``benchmarks/bench_faults.py`` (3 kills).
+
+Six simulated 6-h arcs run as ``odpipe batch`` on a local Dask cluster; the whole process group is
+killed at random moments and the batch rerun. ``fault_loop`` asserts, after every kill, that no
+finished arc was lost or redone and every ``current`` verifies; for every night that ends, that each
+arc was fitted exactly once, every product parses, the night's report is complete and no temporary
+file is left.
+"""
+
+import pytest
+
+from benchmarks.bench_faults import fault_loop
+
+
+@pytest.mark.slow
+def test_a_batch_killed_at_random_moments_loses_nothing_and_fits_each_arc_once(tmp_path):
+    s = fault_loop(tmp_path, kills=3, arcs=6, seed=2, say=lambda line: None)
+    assert s["kills"] == 3 and s["processes_killed"] >= 3   # at least the client each time
+    assert s["nights"] >= 1 and s["products_parsed"] >= s["nights"] * 6 * 15

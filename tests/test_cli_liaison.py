@@ -1,0 +1,67 @@
+"""``odpipe liaison`` takes several configurations (``odpipe liaison runs/liaison_*.toml``): all are checked
+before any runs, each runs into its own folder, one failing does not stop the others.
+The scenario itself is replaced here by a stand-in (the real runs: tests/test_liaison_*.py)."""
+
+import json
+from pathlib import Path
+
+import pytest
+
+import odpipe.liaison.baseline
+from odpipe.cli import main
+
+RUNS = Path(__file__).resolve().parents[1] / "runs"
+
+
+@pytest.fixture
+def scenario(monkeypatch):
+    """The baseline scenario's run replaced: writes report.md with its seed, fails when the seed is 13."""
+    ran = []
+
+    def fake(cfg, out, log=print):
+        log(f"seed {cfg['seed']}")
+        if cfg["seed"] == 13:
+            raise ValueError(f"seed {cfg['seed']}: an unlucky value")
+        ran.append(cfg["seed"])
+        (out / "report.md").write_text(f"seed {cfg['seed']}\n")
+        return {}
+    monkeypatch.setattr(odpipe.liaison.baseline, "run", fake)
+    return ran
+
+
+def _configs(tmp_path, *seeds):
+    text = (RUNS / "liaison_baseline.toml").read_text()
+    paths = []
+    for s in seeds:
+        p = tmp_path / f"liaison_{s}.toml"
+        p.write_text(text.replace("seed = 2012", f"seed = {s}"))
+        paths.append(p)
+    return paths
+
+
+def test_several_configurations_run_into_their_own_folders(tmp_path, capsys, scenario):
+    paths = _configs(tmp_path, 1, 2)
+    assert main(["liaison", *map(str, paths), "-o", str(tmp_path / "out")]) == 0
+    out = capsys.readouterr()
+    assert out.out.splitlines() == [f"report: {tmp_path / 'out' / p.stem / 'report.md'}" for p in paths]
+    assert scenario == [1, 2] and "seed 1\n" in out.err
+    for p in paths:
+        assert json.loads((tmp_path / "out" / p.stem / "manifest.json").read_text())["config"] == str(p)
+
+
+def test_one_failing_scenario_does_not_stop_the_others(tmp_path, capsys, scenario):
+    paths = _configs(tmp_path, 13, 2)
+    assert main(["liaison", *map(str, paths), "-o", str(tmp_path / "out")]) == 4
+    out = capsys.readouterr()
+    assert out.out.splitlines() == [f"report: {tmp_path / 'out' / 'liaison_2' / 'report.md'}"]
+    assert f"error: {paths[0]}: seed 13: an unlucky value" in out.err.splitlines()
+    assert scenario == [2]
+
+
+def test_a_wrong_configuration_stops_all_before_any_runs(tmp_path, capsys, scenario):
+    paths = _configs(tmp_path, 1, 2)
+    paths[1].write_text(paths[1].read_text().replace("cadence_s", "cadense_s"))
+    assert main(["liaison", *map(str, paths), "-o", str(tmp_path / "out")]) == 2
+    (line,) = capsys.readouterr().err.splitlines()
+    assert line.startswith(f"error: {paths[1]}:5: [cadense_s] unknown key (allowed: arc_days, cadence_s,")
+    assert scenario == [] and not (tmp_path / "out").exists()
