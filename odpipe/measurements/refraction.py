@@ -41,7 +41,8 @@ def bending(elevation, height_m):
 def minimal_elevation(height_m):
     """Lowest elevation (rad) a station at ``height_m`` sees, eq. 10: -acos(R/(R+h) n(0)/n(h))."""
     h = np.asarray(height_m, dtype=float)
-    return -np.arccos(EARTH_RADIUS_M / (EARTH_RADIUS_M + h) * (1 + N_SURFACE) / (1 + N_SURFACE * np.exp(-h / N_SCALE_M)))
+    n_ratio = (1 + N_SURFACE) / (1 + N_SURFACE * np.exp(-h / N_SCALE_M))
+    return -np.arccos(EARTH_RADIUS_M / (EARTH_RADIUS_M + h) * n_ratio)
 
 
 @lru_cache(maxsize=256)

@@ -124,22 +124,33 @@ ANGLE_UNITS = {"rad": 1.0, "deg": np.pi / 180.0, "mdeg": np.pi / 180e3, "arcsec"
 
 
 def sigma_value(key: str, value) -> float:
-    """A data_sigma entry as a number: angles may carry their unit ("0.01 deg"); bare numbers as given."""
+    """A data_sigma entry as a number: angles may carry their unit ("0.01 deg"); bare numbers as given.
+    ValueError saying why when a string is not one."""
     if not isinstance(value, str):
         return float(value)
     number, _, unit = value.strip().partition(" ")
-    if not key.startswith("angle_") or unit.strip() not in ANGLE_UNITS:
-        raise ValueError(f"data_sigma[{key!r}] = {value!r}: only angle observables take a unit, one of "
-                         f"{sorted(ANGLE_UNITS)}")
-    return float(number) * ANGLE_UNITS[unit.strip()]
+    try:
+        x = float(number)
+    except ValueError:
+        x = None
+    if not key.startswith("angle_"):
+        raise ValueError(f"{value!r} is not a number (only angle observables take a unit)")
+    if x is None or unit.strip() not in ANGLE_UNITS:
+        raise ValueError(f"{value!r} is not an angle with its unit, one of {sorted(ANGLE_UNITS)}")
+    return x * ANGLE_UNITS[unit.strip()]
 
 
 def data_sigma(rows: pd.DataFrame, sigmas: dict) -> np.ndarray:
     """Per-row sigma (m or m/s; rad for angle rows): the "observable:station_rx" entry if there is one, else
     the observable's."""
-    sigmas = {k: sigma_value(k, v) for k, v in sigmas.items()}
-    by_station = (rows["observable"] + ":" + rows["station_rx"].astype(str)).map(sigmas)
-    return by_station.fillna(rows["observable"].map(sigmas)).to_numpy(float)
+    values = {}
+    for k, v in sigmas.items():
+        try:
+            values[k] = sigma_value(k, v)
+        except ValueError as exc:
+            raise ValueError(f"data_sigma.{k}: {exc}") from None
+    by_station = (rows["observable"] + ":" + rows["station_rx"].astype(str)).map(values)
+    return by_station.fillna(rows["observable"].map(values)).to_numpy(float)
 
 
 def reception_times(rows: pd.DataFrame) -> np.ndarray:

@@ -75,7 +75,7 @@ def _data_sigmas(value: dict) -> list[tuple[str, str]]:
             out.append((f".{key}", str(exc)))
             continue
         if not (s > 0 and np.isfinite(s)):
-            out.append((f".{key}", "must be positive and finite"))
+            out.append((f".{key}", f"{v!r} must be positive and finite"))
     return out
 
 
