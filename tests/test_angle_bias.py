@@ -116,3 +116,14 @@ def test_run_config_takes_angle_sigmas_with_units(tmp_path):
                                                     'data_sigma = { range = "1 m" }'))
     with pytest.raises(ConfigError, match=r"arc.toml:\d+: \[estimation\.data_sigma\.range\] '1 m' is not a number"):
         load_config(tmp_path / "arc.toml")
+
+
+def test_azimuth_residuals_across_north_are_small():
+    from types import SimpleNamespace
+
+    from odpipe.measurements import residuals
+
+    rows = pd.DataFrame({"observable": ["angle_az", "angle_az", "angle_el"], "value": np.radians([0.1, 359.9, 0.1])})
+    res, los = residuals(rows, SimpleNamespace(value=np.radians([359.9, 0.1, 359.9]), to_los=2.0))
+    assert np.degrees(res) == pytest.approx([0.2, -0.2, -359.8], abs=1e-9)
+    assert los == pytest.approx(2 * res)
