@@ -2,9 +2,10 @@
 
 Range rows with a finite ``range_modulus`` (TRK-2-34) or ``range_modulus_ru`` (ODF), in RU, are wrapped into [-M/2, M/2):
 the ambiguity is resolved to the computed value; azimuth residuals are wrapped into
-[-pi, pi) (a track across north). The line-of-sight form multiplies by :attr:`Evaluation.to_los`: metres of one-way range for range
-types (RU -> m: c / (2 F f_up)), m/s of range-rate for Doppler (Hz -> m/s:
-c / (2 M2 f_up) two/three-way, c / f one-way), metres across the sky for angles.
+[-pi, pi) (a track across north). The line-of-sight form multiplies by
+:attr:`Evaluation.to_los`: metres of one-way range for range types (RU -> m: c / (2 F f_up)), m/s of
+range-rate for Doppler (Hz -> m/s: c / (2 M2 f_up) two/three-way, c / f one-way), metres across the sky
+for angles.
 """
 
 from __future__ import annotations
