@@ -180,3 +180,28 @@ def test_other_libraries_progress_stays_quiet(fake_run, capsys):
     finally:
         dask.setLevel(before)
     assert capsys.readouterr().err == "warning: Worker is at 85% memory usage\n"
+
+
+def test_apriori_refuses_a_run_that_is_not_about_the_moon(tmp_path, capsys):
+    """`odpipe apriori` on the peers' Earth-orbit case: one line naming the config and its centre, status 2."""
+    from heo_case import write_config
+
+    import pandas as pd
+
+    write_config(tmp_path, "heo", "2003-06-03T00:00:00", "2003-06-03T06:00:00", [7e6, 0, 0, 0, 7.5e3, 0], "")
+    pd.DataFrame({"epoch": []}).to_parquet(tmp_path / "tracking.parquet")  # never read: the centre is refused first
+    assert main(["apriori", str(tmp_path / "arc.toml")]) == 2
+    err = capsys.readouterr().err.strip()
+    assert err.count("\n") == 0 and "arc.toml" in err and "dynamics.center" in err and "lunar orbiter" in err
+
+
+def test_simulate_case_errors_name_the_file_and_key(tmp_path, capsys):
+    text = (ROOT / "runs" / "artemis_p2_like.toml").read_text()
+    (tmp_path / "noseed.toml").write_text("\n".join(ln for ln in text.splitlines() if not ln.startswith("seed")))
+    assert main(["simulate", str(tmp_path / "noseed.toml"), "-o", str(tmp_path / "out")]) == 2
+    assert _stderr_lines(capsys) == [f"error: {tmp_path / 'noseed.toml'}: [seed] required key is missing"]
+    (tmp_path / "pass.toml").write_text(text.replace("\npass_s =", "\npass_sec ="))
+    assert main(["simulate", str(tmp_path / "pass.toml"), "-o", str(tmp_path / "out")]) == 2
+    assert _stderr_lines(capsys) == [f"error: {tmp_path / 'pass.toml'}: [network] got an unexpected keyword "
+                                     "argument 'pass_sec'"]
+    assert not (tmp_path / "out").exists()

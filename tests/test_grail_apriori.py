@@ -24,13 +24,13 @@ def _orbit(shared_data, odf_name: str, day: str, station: str, hours: float):
     the GRAIL start arc's configuration (DE421, lpe200 to degree 12, Earth and Sun) on one ODF and day."""
     from dataclasses import replace
 
-    from odpipe.pipeline.apriori import DopplerApriori, doppler_apriori
-    from odpipe.pipeline.config import load_config
+    from odpipe.pipeline.apriori import doppler_apriori
+    from odpipe.pipeline.config import DopplerAprioriSection, load_config
 
     cfg = load_config(ROOT / "runs" / "grail_b_2012_04_09_start.toml")
     cfg = replace(cfg, data=replace(cfg.data, files=[shared_data / "grail" / odf_name]),
                   arc=replace(cfg.arc, start=f"2012-04-{day}T00:00:00", end=f"2012-04-{day}T23:59:59"))
-    result, rows = doppler_apriori(cfg, DopplerApriori(station, hours, 12))
+    result, rows = doppler_apriori(cfg, DopplerAprioriSection(station, hours, 12))
     return rows, result
 
 

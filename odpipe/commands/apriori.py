@@ -19,11 +19,11 @@ def add_arguments(parser) -> None:
 
 
 def run(args) -> int:
-    from odpipe.pipeline.apriori import DopplerApriori, doppler_apriori, initial_state_toml
-    from odpipe.pipeline.config import load_config
+    from odpipe.pipeline.apriori import doppler_apriori, initial_state_toml
+    from odpipe.pipeline.config import DopplerAprioriSection, load_config
 
     cfg = load_config(args.config)
-    res, rows = doppler_apriori(cfg, DopplerApriori(args.station, args.span, args.degree))
+    res, rows = doppler_apriori(cfg, DopplerAprioriSection(args.station, args.span, args.degree))
     el = res.elements
     print(f"# {len(rows)} 60-s two-way Doppler points of {rows['station_rx'].iloc[0]}, "
           f"{rows['epoch'].min():%Y-%m-%dT%H:%M:%S} .. {rows['epoch'].max():%Y-%m-%dT%H:%M:%S} UTC; "

@@ -87,7 +87,8 @@ def doppler_rows(table: pd.DataFrame, ramps: pd.DataFrame, spacecraft: str, coun
     one- or few-sample windows whose uplink is often not yet covered by the ramps.
     """
     sel = (table["observable"] == "doppler_2way").to_numpy() & (table["spacecraft"].astype(str) == spacecraft).to_numpy()
-    edited, _ = edit(table[sel].reset_index(drop=True), ramps, EditConfig())
+    # no geometry yet (the orbit is what is sought): no elevation mask
+    edited, _ = edit(table[sel].reset_index(drop=True), ramps, EditConfig(min_elevation=-np.inf))
     rows, _ = compress(edited, count_time, ramps=ramps)
     keep = (rows["flags"].to_numpy() == 0) & (rows["count_time"].to_numpy(float) >= min_count)
     return rows[keep].reset_index(drop=True)

@@ -9,8 +9,6 @@ body's principal-axis frame.
 
 from __future__ import annotations
 
-from dataclasses import dataclass
-
 import numpy as np
 import pandas as pd
 
@@ -21,7 +19,7 @@ from odpipe.frames.earth import gcrs_to_itrs
 from odpipe.frames.moon import moon_pa_to_icrf
 from odpipe.measurements import MeasurementSetup
 from odpipe.od.apriori import AprioriResult, determine_orbit, doppler_rows
-from odpipe.pipeline.config import RunConfig
+from odpipe.pipeline.config import DopplerAprioriSection, RunConfig
 from odpipe.pipeline.ingest import ingest
 from odpipe.pipeline.setup import station_catalog
 from odpipe.runs.schema import ConfigError
@@ -30,18 +28,10 @@ from odpipe.time import tdb_to_utc
 FRAMES = {"moon": moon_pa_to_icrf}  # central body -> its body-fixed (PA) frame to ICRF, for the grid search
 
 
-@dataclass(frozen=True)
-class DopplerApriori:
-    """How the a priori orbit is found: station (None: the busiest in the first 8 h), the span of its
-    Doppler used (h), and the degree of the central body's field in the refinement."""
-
-    station: str | None = None
-    span_hours: float = 5.5
-    degree: int = 12
-
-
-def doppler_apriori(cfg: RunConfig, how: DopplerApriori = DopplerApriori()) -> tuple[AprioriResult, pd.DataFrame]:
-    """The a priori epoch state of ``cfg``'s arc from its Doppler, and the rows it used."""
+def doppler_apriori(cfg: RunConfig, how: DopplerAprioriSection | None = None) -> tuple[AprioriResult, pd.DataFrame]:
+    """The a priori epoch state of ``cfg``'s arc from its Doppler, and the rows it used (``how``: the
+    configuration's ``initial_state.from_doppler``, else the defaults)."""
+    how = how or cfg.initial_state.from_doppler or DopplerAprioriSection()
     center = cfg.dynamics.center.lower()
     if center not in FRAMES:
         raise ConfigError(cfg.path, "dynamics.center", f"an a priori orbit from Doppler needs a lunar orbiter, "

@@ -12,7 +12,10 @@ with its line.
 
 from __future__ import annotations
 
+import functools
+import importlib
 import re
+import typing
 import warnings
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -22,7 +25,16 @@ import numpy as np
 
 from odpipe.runs.schema import (at_least, between, checked, file_name, internal, load, positive, read_toml,
                                 readable, readable_files)
-TRACKING_READERS = ("parsers.odf", "parsers.utdf", "parsers.trk234", "parsers.tdm")  # formats.READERS of tracking
+
+
+@functools.cache
+def tracking_readers() -> tuple[str, ...]:
+    """The reader modules of :mod:`parsers.formats` whose ``read`` returns TrackingData."""
+    from parsers import formats
+    from parsers.table import TrackingData
+
+    return tuple(n for n in formats.available()
+                 if typing.get_type_hints(importlib.import_module(n).read).get("return") is TrackingData)
 
 
 def utc_time(value: str) -> list[tuple[str, str]]:
@@ -79,23 +91,23 @@ def _data_sigmas(value: dict) -> list[tuple[str, str]]:
     return out
 
 
-def _files_of(readers: tuple[str, ...], what: str):
-    """Check: a path (or every path of a list) is a readable file of one of ``readers``."""
+def _files_of(readers, what: str):
+    """Check: a path (or every path of a list) is a readable file of one of ``readers()``."""
     return lambda paths: [("", why) for p in (paths if isinstance(paths, list) else [paths])
-                          if (why := _recognised(p, readers, what))]
+                          if (why := _recognised(p, readers(), what))]
 
 
 @dataclass
 class RunSection:
-    name: str = checked(file_name)  # one folder name: runs go to OUTPUT/NAME (attempt folders and 'current')
-    output: Path = Path("out")
+    name: str = checked(file_name)  # a plain folder name (no '/', '..'): the run's folder is OUTPUT/NAME
+    output: Path = Path("out")  # runs go to OUTPUT/NAME (attempt folders and 'current')
 
 
 @dataclass
 class ArcSection:
     spacecraft: str  # id as the tracking files give it, e.g. "181"
-    start: str = checked(utc_time)
-    end: str = checked(utc_time)
+    start: str = checked(utc_time)  # UTC ISO time, e.g. "2012-04-09T04:00:00"
+    end: str = checked(utc_time)  # UTC ISO time, after the start
 
     def problems(self):
         if _utc(self.end) <= _utc(self.start):
@@ -104,7 +116,8 @@ class ArcSection:
 
 @dataclass
 class DataSection:
-    files: list[Path] = checked(_files_of(TRACKING_READERS, "tracking"))
+    # tracking files (globs allowed): any format parsers.formats reads as tracking data, or TrackingTable .parquet
+    files: list[Path] = checked(_files_of(tracking_readers, "tracking"))
     # station CSVs added to the default catalog
     stations: list[Path] = checked(readable_files, default_factory=list)
     # observables fitted; "observable:BAND" keeps only rows of that downlink band (e.g. "doppler_1way:X")
@@ -115,54 +128,67 @@ class DataSection:
 @dataclass
 class CalibrationSection:
     media: bool = True  # false: the table's values are already corrected (or simulated without media)
-    tro: list[Path] = checked(_files_of(("parsers.trk223",), "TRK-2-23"), default_factory=list)
-    ion: list[Path] = checked(_files_of(("parsers.trk223",), "TRK-2-23"), default_factory=list)
-    ionex: list[Path] = checked(_files_of(("parsers.ionex",), "IONEX"), default_factory=list)
+    # DSN TRK-2-23 troposphere cards (.TRO); without them the DSN seasonal model (or Saastamoinen)
+    tro: list[Path] = checked(_files_of(lambda: ("parsers.trk223",), "TRK-2-23"), default_factory=list)
+    # DSN TRK-2-23 ionosphere cards (.ION)
+    ion: list[Path] = checked(_files_of(lambda: ("parsers.trk223",), "TRK-2-23"), default_factory=list)
+    # IONEX maps (TEC -> delay at each leg's frequency), where no .ION card covers
+    ionex: list[Path] = checked(_files_of(lambda: ("parsers.ionex",), "IONEX"), default_factory=list)
     smoothing_order: int = checked(at_least(-1), default=10)  # per-pass polynomial; -1 = none
 
 
 @dataclass
 class PreprocessSection:
     count_time: float = checked(positive, default=60.0)  # s, Doppler compression target
+    # compressed windows cut short (gaps, ramp segments): keep them, flag them, or drop them
     partial: Literal["keep", "flag", "drop"] = "keep"
-    elevation_mask_deg: float = checked(between(-90.0, 90.0), default=10.0)
-    blunder_k: float = checked(positive, default=10.0)
-    min_pass_samples: int = checked(at_least(1), default=10)
+    elevation_mask_deg: float = checked(between(-90.0, 90.0), default=10.0)  # deg, at the receiving station
+    blunder_k: float = checked(positive, default=10.0)  # robust sigmas of a pass's detrended values: BLUNDER
+    min_pass_samples: int = checked(at_least(1), default=10)  # passes with fewer rows are flagged SHORT_PASS
 
 
 @dataclass
 class GravitySection:
-    body: str
-    file: Path = checked(readable_files)
-    degree: int = checked(at_least(0))
-    partial_degree: int | None = checked(at_least(0), default=None)
+    body: str  # the field's body, e.g. "moon" or "earth"
+    file: Path = checked(readable_files)  # ICGEM, GMAT .cof, PDS SHADR, EGM or plain-table field
+    degree: int = checked(at_least(0))  # degree and order evaluated
+    partial_degree: int | None = checked(at_least(0), default=None)  # degree of the STM partials (none: degree)
 
 
 @dataclass
 class CylinderSection:
-    radius: float = checked(positive)
-    length: float = checked(positive)
-    rho_s: float = checked(between(0.0, 1.0), default=0.0)
-    rho_d: float = checked(between(0.0, 1.0), default=0.0)
+    radius: float = checked(positive)  # m
+    length: float = checked(positive)  # m
+    rho_s: float = checked(between(0.0, 1.0), default=0.0)  # specular reflectivity
+    rho_d: float = checked(between(0.0, 1.0), default=0.0)  # diffuse reflectivity
     axis: str | list[float] = "sun"  # spin axis: ICRF unit vector or 'sun'
 
 
 @dataclass
 class SrpSection:
     cr_area: float = checked(at_least(0.0), default=0.0)  # Cr·A, m² (cannonball)
-    cylinder: CylinderSection | None = None
-    occulters: list[str] = field(default_factory=lambda: ["earth", "moon"])
+    cylinder: CylinderSection | None = None  # a spin-stabilised cylinder instead of the cannonball
+    occulters: list[str] = field(default_factory=lambda: ["earth", "moon"])  # bodies casting shadows (conical)
 
 
 @dataclass
 class DynamicsSection:
-    center: str
+    center: str  # central body of the integration, e.g. "earth", "moon", "ssb"
     ephemeris: str = "de440"  # 'de440', 'de421' or a .bsp path
-    third_bodies: list[str] = field(default_factory=list)
-    gravity: list[GravitySection] = field(default_factory=list)
-    srp: SrpSection | None = None
+    third_bodies: list[str] = field(default_factory=list)  # point masses, e.g. ["sun", "moon"]
+    gravity: list[GravitySection] = field(default_factory=list)  # spherical-harmonic fields ([[dynamics.gravity]])
+    srp: SrpSection | None = None  # solar radiation pressure (none: off)
     mass: float = checked(positive, default=1000.0)  # kg
-    relativity: bool = False
+    relativity: bool = False  # the central body's post-Newtonian term
+
+
+@dataclass
+class DopplerAprioriSection:
+    """How the a priori orbit is found in the arc's two-way Doppler (lunar orbiters; ``odpipe apriori``)."""
+
+    station: str | None = None  # receiving station used (none: the one with most 60-s points in the first 8 h)
+    span_hours: float = checked(positive, default=5.5)  # h of that station's Doppler used
+    degree: int = checked(at_least(2), default=12)  # degree of the central body's field in the search
 
 
 @dataclass
@@ -171,15 +197,19 @@ class InitialStateSection:
     previous arc's ``OUTPUT/NAME/current/trajectory.oem`` (a nightly chain; ``odpipe batch`` runs
     that arc first, so the file need not exist when the configuration is loaded)."""
 
-    epoch: str = checked(utc_time)  # UTC
+    epoch: str | None = checked(utc_time, default=None)  # UTC ISO time of the state (from_doppler: none)
     state: list[float] | None = None  # m, m/s, ICRF axes about dynamics.center
-    from_oem: Path | None = None
+    from_oem: Path | None = None  # OEM whose state at epoch is the a priori (e.g. the previous arc's)
+    # find the a priori orbit in the arc's own two-way Doppler (odpipe apriori); its epoch is the data's
+    from_doppler: DopplerAprioriSection | None = None
 
     def problems(self):
-        if (self.state is None) == (self.from_oem is None):
-            yield "", "give either state or from_oem"
+        if sum(x is not None for x in (self.state, self.from_oem, self.from_doppler)) != 1:
+            yield "", "give one of state, from_oem or from_doppler"
         elif self.state is not None and (len(self.state) != 6 or not np.all(np.isfinite(self.state))):
             yield "state", "needs 6 finite numbers (m, m/s)"
+        if self.epoch is None and self.from_doppler is None:
+            yield "epoch", "required key is missing"
 
 
 @dataclass
@@ -191,26 +221,27 @@ class StochasticSection:
 
 @dataclass
 class EstimationSection:
-    sigma_position: float = checked(positive, default=100e3)
-    sigma_velocity: float = checked(positive, default=1.0)
-    srp_scale_sigma: float | None = checked(positive, default=0.1)
-    stochastic: StochasticSection | None = None
+    sigma_position: float = checked(positive, default=100e3)  # m, a priori, per axis
+    sigma_velocity: float = checked(positive, default=1.0)  # m/s, a priori, per axis
+    srp_scale_sigma: float | None = checked(positive, default=0.1)  # a priori sigma of the SRP scale (none: fixed)
+    stochastic: StochasticSection | None = None  # Gauss-Markov RTN accelerations (none: off)
     # LOS sigma (m, m/s) by "observable" or "observable:station" (the station's entry wins); angle observables:
-    # the angle's sigma, rad or with its unit ("0.01 deg", "36 arcsec")
+    # the angle's own sigma, a number in rad or a string with its unit ("0.01 deg", "36 arcsec", "1e-4 rad")
     data_sigma: dict[str, float | str] = checked(lambda v: _data_sigmas(v),
                                                  default_factory=lambda: {"range": 2.0, "doppler_2way": 1e-4})
-    range_bias_sigma: float | None = checked(positive, default=5.0)
+    range_bias_sigma: float | None = checked(positive, default=5.0)  # m, a per-pass range bias (none: not estimated)
     # one-way Doppler's oscillator, estimated when set: sigmas of its fractional frequency offset y0 and drift
     # y1 (1/s) about the arc start, one pair for every band it drives (a priori 0: the rows' reference)
     oscillator_sigma: list[float] | None = checked(positive, default=None)
     # planned maneuvers (parsers.maneuvers schema)
-    maneuver_plan: Path | None = checked(_files_of(("parsers.maneuvers",), "maneuver plan"), default=None)
+    maneuver_plan: Path | None = checked(_files_of(lambda: ("parsers.maneuvers",), "maneuver plan"), default=None)
     # s: estimate planned burns' epochs (a plan's sigma_time wins)
     maneuver_epoch_sigma: float | None = checked(positive, default=None)
+    # innovation editing threshold (sigmas) per iteration, the last repeated; inf edits nothing
     edit_k: list[float] = checked(lambda v: positive(v, allow_inf=True),
                                   default_factory=lambda: [float("inf"), 10.0, 5.0])
-    max_iter: int = checked(at_least(1), default=10)
-    reweight: bool = False  # ARTEMIS reweighting from post-fit RMS; see README (known instability)
+    max_iter: int = checked(at_least(1), default=10)  # filter-smoother iterations at most
+    reweight: bool = False  # data weights from each station's post-fit RMS (the ARTEMIS practice); see README
     # data-weight stages multiplying every sigma, loose to tight (e.g. [30, 5, 1]): the next stage starts once
     # the epoch correction is below 1 sigma, so a far-off a priori is not fitted at full weight at once
     sigma_scale: list[float] = checked(positive, default_factory=lambda: [1.0])
@@ -228,12 +259,12 @@ class EstimationSection:
 
 @dataclass
 class ProductsSection:
-    oem: bool = True
-    spk: bool = True
-    naif_id: int = -999
-    object_name: str = ""
+    oem: bool = True  # write trajectory.oem (CCSDS OEM with covariance)
+    spk: bool = True  # write trajectory.bsp (SPK type 13)
+    naif_id: int = -999  # the SPK's body id
+    object_name: str = ""  # OEM OBJECT_NAME (default: the spacecraft id)
     step: float = checked(positive, default=60.0)  # s between trajectory product states
-    plots: bool = True
+    plots: bool = True  # residual plots per station and observable
 
 
 @dataclass

@@ -32,7 +32,6 @@ from odpipe.pipeline.ingest import ingest
 from odpipe.pipeline.products import fitted_segments
 from odpipe.preprocess.compress import compress
 from odpipe.preprocess.edit import EditConfig, edit
-from odpipe.preprocess.flags import summary as flag_summary
 from odpipe.products import parameters, residuals
 from odpipe.products.atomic import write_parquet, write_text
 from odpipe.products.oem import write_oem

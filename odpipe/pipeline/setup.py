@@ -92,17 +92,24 @@ def station_catalog(cfg: RunConfig) -> StationCatalog:
     return catalog
 
 
-def initial_state(cfg: RunConfig, t_tdb: float) -> np.ndarray:
-    """The configured a priori state (m, m/s, ICRF about the dynamics centre) at ``t_tdb``."""
+def initial_state(cfg: RunConfig) -> tuple[float, np.ndarray]:
+    """The configured a priori epoch (TDB s) and state (m, m/s, ICRF about the dynamics centre): given, read
+    from an OEM at the epoch, or found in the arc's own Doppler (then at the first Doppler point used)."""
     init = cfg.initial_state
+    if init.from_doppler is not None:
+        from odpipe.pipeline.apriori import doppler_apriori  # it reads the data through this module
+
+        result, _ = doppler_apriori(cfg)
+        return result.epoch, result.state
+    t_tdb = tdb(init.epoch)
     if init.from_oem is None:
-        return np.asarray(init.state, float)
+        return t_tdb, np.asarray(init.state, float)
     traj = oem_trajectory(init.from_oem)
     if traj.center != cfg.dynamics.center.lower():
         raise ConfigError(cfg.path, "initial_state.from_oem",
                           f"{init.from_oem} is about {traj.center}, the dynamics about {cfg.dynamics.center}")
     try:
-        return traj.state(t_tdb)[0]
+        return t_tdb, traj.state(t_tdb)[0]
     except ValueError as err:
         raise ConfigError(cfg.path, "initial_state.epoch", f"{init.epoch} is not covered by {init.from_oem}: {err}")
 
@@ -110,8 +117,7 @@ def initial_state(cfg: RunConfig, t_tdb: float) -> np.ndarray:
 def arc_setup(cfg: RunConfig, fm: F.ForceModel, ramps, catalog: StationCatalog) -> ArcSetup:
     est = cfg.estimation
     start, end = tdb(cfg.arc.start), tdb(cfg.arc.end)
-    t_state = tdb(cfg.initial_state.epoch)
-    state0 = initial_state(cfg, t_state)
+    t_state, state0 = initial_state(cfg)
     if abs(t_state - start) > 1e-6:  # move the a priori state to the arc start
         state0 = propagate(state0, t_state, start, fm, with_stm=False).state(start)[0]
     oscillators = {} if est.oscillator_sigma is None else {cfg.arc.spacecraft: (0.0, 0.0, start)}

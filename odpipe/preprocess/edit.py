@@ -37,7 +37,7 @@ log = logging.getLogger(__name__)
 class EditConfig:
     """Editing settings (SI: s, rad)."""
 
-    min_elevation: float = np.radians(10.0)
+    min_elevation: float = np.radians(10.0)  # rad; -inf: no elevation mask
     blunder_k: float = 10.0         # robust sigmas of the spike deviation
     gross_k: float = 5.0            # 10-90 % spreads of the pass's values
     min_pass_samples: int = 10
@@ -182,7 +182,8 @@ def edit(table: pd.DataFrame, ramps: pd.DataFrame | None = None, config: EditCon
         flags = set_flag(flags, outside_arc(out, *config.arc), Flag.OUTSIDE_ARC)
     flags = set_flag(flags, in_windows(out, config.windows), Flag.USER)
     out["flags"] = flags
-    _warn_unmasked(out, flags)
+    if np.isfinite(config.min_elevation):  # -inf: no mask asked for, nothing to warn of
+        _warn_unmasked(out, flags)
     return out, summary(flags)
 
 

@@ -47,7 +47,7 @@ def type_name(hint) -> str:
     if origin is typing.Literal:
         return " \\| ".join(f'`"{a}"`' if isinstance(a, str) else f"`{a}`" for a in args)
     if dataclasses.is_dataclass(hint):
-        return f"table [{hint.__name__}]"
+        return "table (its keys below)"
     return {Path: "path", float: "number", int: "integer", str: "string", bool: "boolean",
             typing.Any: "any"}.get(hint, getattr(hint, "__name__", str(hint)))
 
