@@ -5,10 +5,10 @@ The direction is the light-time-corrected one, d = r_sc(t2) - r_station(t3)
 east-north-up axes through ITRS at t3 (geodetic latitude/longitude, WGS84).
 Azimuth from north through east in [0, 2 pi), elevation above the horizon;
 X/Y are the CCSDS ``XEYN`` pair: X = atan2(east, up), Y = asin(north / |d|).
-Aberration and refraction are not modelled (refraction belongs to media
-corrections). Partials include the motion of the spacecraft over the change
-of light time: dd/dr_sc = I - v_sc g^T, with g = d tau / d r_sc. Station
-partials also turn the local axes: d lat = d north/(M + h), d lon =
+Aberration is not modelled; refraction of the elevation is :mod:`.refraction`,
+applied by :func:`.compute.compute` when the setup asks for it. Partials include
+the motion of the spacecraft over the change of light time: dd/dr_sc = I - v_sc g^T,
+with g = d tau / d r_sc. Station partials also turn the local axes: d lat = d north/(M + h), d lon =
 d east/((N + h) cos lat) on the WGS84 ellipsoid (M, N its radii of curvature).
 """
 

@@ -16,7 +16,7 @@ doppler_2way/3way  count-averaged Doppler (Hz), interval from ``epoch``/``tag``/
 doppler_1way       f_ref = ``uplink_hz`` (ODF rows: times 880/240 for X, 3344/240 for Ka downlinks, as
                    the ODF gives it at S-band scale); the oscillator from ``setup.oscillators``
                    (default: nominal f_ref, no bias or drift).
-angle_az/el/x/y    antenna angles at reception (rad).
+angle_az/el/x/y    antenna angles at reception (rad); elevations apparent with ``setup.elevation_refraction``.
 range_rate         instantaneous station-spacecraft range-rate at reception (m/s), for studies.
 sst_range          crosslink two-way range (m); ``spacecraft`` = sc1 (transmits and receives,
 sst_doppler        time tag at its reception), extra column ``spacecraft_2`` = sc2;
@@ -53,8 +53,8 @@ from odpipe.environment.ephemeris import SpanEphemeris
 from odpipe.frames.tabulated import TabulatedRotation
 from odpipe.preprocess.timetags import interval_bounds
 
-from . import angles, crosslink, dsn, instantaneous
-from .bands import ONE_WAY_SCALE, band_name, range_unit_factor, turnaround_ratio
+from . import angles, crosslink, dsn, instantaneous, refraction
+from .bands import C_LIGHT, ONE_WAY_SCALE, band_name, range_unit_factor, turnaround_ratio
 from .computed import Computed, ConstantUplink
 from .lighttime import anchor_from_utc, solve_path
 from .nodes import SpacecraftNode, StationNode, proper_rate_offset
@@ -70,6 +70,10 @@ class MeasurementSetup:
     oscillators: spacecraft -> (y0, y1 1/s, t_ref TDB s) of its one-way oscillator: fractional frequency
     offset from each row's reference frequency and its drift (:func:`.dsn.one_way_doppler`).
     clocks: spacecraft -> :class:`.crosslink.ClockModel` for dual one-way ranging.
+    com_offsets: spacecraft -> centre-of-mass offset (m) of its ranging reflector or antenna towards the
+    stations (LAGEOS: 0.251 m): each leg of a ``range`` row is that much shorter than to the centre of mass.
+    elevation_refraction: ``angle_el`` rows are apparent elevations, the free-space one bent by the ITU-R P.834
+    reference atmosphere at the station's height (:mod:`.refraction`).
     """
 
     ephemeris: object
@@ -82,6 +86,8 @@ class MeasurementSetup:
     media_in_model: bool = True
     oscillators: dict = field(default_factory=dict)
     clocks: dict = field(default_factory=dict)
+    com_offsets: dict = field(default_factory=dict)
+    elevation_refraction: bool = False
 
     @classmethod
     def default(cls, **kw) -> "MeasurementSetup":
@@ -183,6 +189,7 @@ def _evaluate(key, g, trajectories, setup):
             ru = range_unit_factor(g["band_up"].to_numpy(object))
             modulus = _column(g, ("range_modulus", "range_modulus_ru"))
             delay = np.nan_to_num(g["delay_s"].to_numpy(float)) if "delay_s" in g.columns else 0.0
+            delay = delay - 2.0 * setup.com_offsets.get(sc, 0.0) / C_LIGHT
             if unit not in ("RU", "m", "s"):
                 raise _Unsupported(f"range in unit {unit!r}: only RU, m and s are modelled")
             return dsn.dsn_range(solve(nodes, epoch), up, tx, epoch, ru, unit, delay, modulus), roles
@@ -213,8 +220,10 @@ def _evaluate(key, g, trajectories, setup):
     if obs in _ANGLES:
         st_rx = setup.station(rx)
         sol = solve([setup.spacecraft(traj, sc), st_rx], epoch)
-        return angles.antenna_angle(sol, st_rx, _ANGLES[obs]), {"station_rx": ("station", rx, st_rx),
-                                                                "spacecraft": ("sc", sc, traj)}
+        comp = angles.antenna_angle(sol, st_rx, _ANGLES[obs])
+        if obs == "angle_el" and setup.elevation_refraction:
+            comp = refraction.refracted(comp, setup.stations[rx].geodetic()[2])
+        return comp, {"station_rx": ("station", rx, st_rx), "spacecraft": ("sc", sc, traj)}
     if obs == "range_rate":
         st_rx = setup.station(rx)
         t, c = anchor_from_utc(epoch)

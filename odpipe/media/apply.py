@@ -14,6 +14,8 @@ changes add up to the change over any compressed window. Columns added:
   equivalent is ``media_m / count_time``). Subtract from the observable.
 - ``media_ru``: ``media_m`` of range rows in range units, from the uplink
   frequency at transmission (row value or ramp; NaN when neither is known).
+- Laser rows (a finite ``wavelength_nm``) get the Mendes-Pavlis optical troposphere from the
+  row's own meteorology (:mod:`odpipe.media.mendes_pavlis`) and no ionosphere.
 - ``media_source`` / ``media_source_up``: which file and card (or model)
   gave the downlink / uplink values; ``media_note``: why a fallback was used.
 
@@ -34,6 +36,7 @@ import pandas as pd
 
 from odpipe.environment.stations import StationCatalog, itrs_to_geodetic, topocentric
 from odpipe.measurements.bands import C_LIGHT, range_unit_factor
+from odpipe.media import mendes_pavlis, saastamoinen
 from odpipe.media.model import MediaModel
 from odpipe.media.smoothing import smooth_by_group
 from odpipe.preprocess import ramp_segments
@@ -184,9 +187,41 @@ def _leg_delays(s: pd.DataFrame, table, model: MediaModel, target_itrs, catalog)
                                         s["f"].to_numpy()[idx][sub])
             iono[idx[sub]] = np.where(bad[sub], np.nan, d_i)
             lab_i[idx[sub]] = np.where(bad[sub], "no direction", l_i)
+        optical = _optical(table, s["row"].to_numpy()[idx], el_ok, lat, h)
+        if optical is not None:
+            laser, d_o, l_o = optical
+            d_t, l_t = np.where(laser, d_o, d_t), np.where(laser, l_o, l_t)
+            iono[idx] = np.where(laser & ~bad, 0.0, iono[idx])
+            lab_i[idx] = np.where(laser & ~bad, "not at optical wavelengths", lab_i[idx])
         tropo[idx] = np.where(bad, np.nan, d_t)
         lab_t[idx] = np.where(bad, "no direction", l_t)
     return tropo, iono, lab_t, lab_i
+
+
+def _optical(table, rows, elevation, lat, h):
+    """(laser mask, Mendes-Pavlis delay m, label) of samples whose rows carry ``wavelength_nm``, else None.
+
+    The row's surface meteorology (``pressure_mbar``, ``temperature_k``, ``humidity_pct``) is used
+    for both legs; where any of it is missing, the standard atmosphere at the site.
+    """
+    if "wavelength_nm" not in table.columns:
+        return None
+    laser = np.isfinite(table["wavelength_nm"].to_numpy(dtype=float)[rows])
+    if not laser.any():
+        return None
+    cols = ("pressure_mbar", "temperature_k", "humidity_pct")
+    p, t, rh = (table[c].to_numpy(dtype=float)[rows] if c in table.columns else np.full(rows.size, np.nan)
+                for c in cols)
+    p = p * 100.0
+    e = mendes_pavlis.vapour_pressure(rh, t, p)
+    measured = np.isfinite(p) & np.isfinite(t) & np.isfinite(e)
+    p0, t0, e0 = saastamoinen.standard_atmosphere(h)
+    p, t, e = np.where(measured, p, p0), np.where(measured, t, t0), np.where(measured, e, e0)
+    lam = np.where(laser, table["wavelength_nm"].to_numpy(dtype=float)[rows], 532.0)
+    dry, wet = mendes_pavlis.zenith_delays(p, e, lat, h, lam)
+    delay = (dry + wet) * mendes_pavlis.mapping(elevation, lat, h, t)
+    label = np.where(measured, "Mendes-Pavlis (row meteo)", "Mendes-Pavlis (no meteo)")
+    return laser, delay, label.astype(object)
 
 
 def _direction(station, t, table, target_itrs, st):
@@ -221,6 +256,7 @@ def _notes(n, rows, code, texts, ground, two_leg, rtlt_note):
     """Per row: why its correction is partial or a fallback (from every sample's source text)."""
     reasons = [("(no TRO)", "no TRO coverage: DSN seasonal model used"),
                ("standard-atmosphere", "non-DSN station: standard atmosphere used"),
+               ("(no meteo)", "laser row without meteorology: standard atmosphere used"),
                ("iono: none", "no ionosphere calibration: none applied"),
                ("no direction", "no spacecraft direction or below horizon: no correction"),
                ("no station", "station not in catalog: no correction")]

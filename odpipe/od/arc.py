@@ -53,7 +53,10 @@ class ArcSetup:
     force_model: dynamics without the estimated maneuvers and stochastic accelerations.
     srp_scale_sigma: a priori sigma of the SRP scale (None: not estimated).
     stochastic: RTN Gauss-Markov accelerations (m/s^2; tau 0 = white per batch), or None.
-    data_sigma: sigma along the line of sight (m or m/s) by "observable:station_rx", else by "observable".
+    data_sigma: sigma along the line of sight (m or m/s) by "observable:station_rx", else by "observable";
+    for angle rows (unit rad) the angle's own sigma: a number in rad or a string with its unit, "0.01 deg",
+    "36 arcsec", "1.7e-4 rad" (:data:`ANGLE_UNITS`).
+    angle_bias_sigma: one constant bias (rad) per receiving station and angle observable (None: none).
     range_bias_sigma: per pass and receiving station (m; None: no biases; pass_id -1 = one per station).
     oscillator_sigma: (y0, y1 1/s) sigmas of the one-way oscillator's fractional frequency offset and drift,
     when doppler_1way is fitted (a priori and reference epoch from ``measurements.oscillators``).
@@ -79,6 +82,7 @@ class ArcSetup:
     maneuvers: tuple = ()
     data_sigma: dict = field(default_factory=lambda: {"range": 2.0, "doppler_2way": 1e-4})
     range_bias_sigma: float | None = 5.0
+    angle_bias_sigma: float | None = None
     oscillator_sigma: tuple | None = None
     station_sigma: float | None = None
     media_sigma: float | None = None
@@ -116,10 +120,37 @@ class ArcSolution:
     problem: TrackingProblem
 
 
+ANGLE_UNITS = {"rad": 1.0, "deg": np.pi / 180.0, "mdeg": np.pi / 180e3, "arcsec": np.pi / 648e3}
+
+
+def sigma_value(key: str, value) -> float:
+    """A data_sigma entry as a number: angles may carry their unit ("0.01 deg"); bare numbers as given.
+    ValueError saying why when a string is not one."""
+    if not isinstance(value, str):
+        return float(value)
+    number, _, unit = value.strip().partition(" ")
+    try:
+        x = float(number)
+    except ValueError:
+        x = None
+    if not key.startswith("angle_"):
+        raise ValueError(f"{value!r} is not a number (only angle observables take a unit)")
+    if x is None or unit.strip() not in ANGLE_UNITS:
+        raise ValueError(f"{value!r} is not an angle with its unit, one of {sorted(ANGLE_UNITS)}")
+    return x * ANGLE_UNITS[unit.strip()]
+
+
 def data_sigma(rows: pd.DataFrame, sigmas: dict) -> np.ndarray:
-    """Per-row sigma (m or m/s): the "observable:station_rx" entry if there is one, else the observable's."""
-    by_station = (rows["observable"] + ":" + rows["station_rx"].astype(str)).map(sigmas)
-    return by_station.fillna(rows["observable"].map(sigmas)).to_numpy(float)
+    """Per-row sigma (m or m/s; rad for angle rows): the "observable:station_rx" entry if there is one, else
+    the observable's."""
+    values = {}
+    for k, v in sigmas.items():
+        try:
+            values[k] = sigma_value(k, v)
+        except ValueError as exc:
+            raise ValueError(f"data_sigma.{k}: {exc}") from None
+    by_station = (rows["observable"] + ":" + rows["station_rx"].astype(str)).map(values)
+    return by_station.fillna(rows["observable"].map(values)).to_numpy(float)
 
 
 def reception_times(rows: pd.DataFrame) -> np.ndarray:
@@ -162,6 +193,11 @@ def build_registry(setup: ArcSetup, rows: pd.DataFrame) -> ParameterRegistry:
             if pid >= 0:
                 info["pass_id"] = pid
             reg.add(f"bias.range.{st}.pass{pid}", "bias", 0.0, setup.range_bias_sigma, owner=st, **info)
+    if setup.angle_bias_sigma is not None:
+        ang = rows[rows["unit"] == "rad"]
+        for obs, st in ang[["observable", "station_rx"]].drop_duplicates().itertuples(index=False):
+            reg.add(f"bias.{obs}.{st}", "bias", 0.0, setup.angle_bias_sigma, owner=st, observable=obs, station=st,
+                    spacecraft=sc)
     if setup.oscillator_sigma is not None and (rows["observable"] == "doppler_1way").any():
         y0, y1, _ = setup.measurements.oscillators[sc]
         reg.add(f"{sc}.osc_y0", "clock", y0, setup.oscillator_sigma[0], owner=sc, oscillator="y0")
@@ -207,7 +243,8 @@ def fit_arc(table: pd.DataFrame, setup: ArcSetup) -> ArcSolution:
     if not good.all():
         problem = problem_for(rows[good], times[good])
     used = rows[good]
-    sig = data_sigma(used, setup.data_sigma) / np.abs(to_los[good])  # a sigma <= 0 is the config's, and edited
+    # angle rows: sigma and value in rad; others along the line of sight (a sigma <= 0 is the config's, and edited)
+    sig = data_sigma(used, setup.data_sigma) / np.abs(np.where(used["unit"] == "rad", 1.0, to_los[good]))
     group = (used["observable"] + ":" + used["station_rx"].astype(str)).to_numpy(object)
     obs = Observations(times[good], used["value"].to_numpy(float), sig, group)
     x_ref = None

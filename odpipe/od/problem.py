@@ -15,8 +15,9 @@ maneuver_epoch  offset (s) of that maneuver's firing from its logged epoch (``ad
                 order in the offset (:mod:`.segment`)
 clock           one-way oscillator: ``info['oscillator']`` 'y0' (fractional frequency offset) or 'y1'
                 (its drift, 1/s); the reference epoch from ``setup.oscillators[sc]``
-bias            measurement bias along the line of sight (m for range, m/s for Doppler) of the rows
-                matching ``info`` keys ``observable``, ``station`` (receiver), ``pass_id``, ``spacecraft``
+bias            measurement bias along the line of sight (m for range, m/s for Doppler; an angle in rad for
+                angle rows, unit 'rad') of the rows matching ``info`` keys ``observable``, ``station``
+                (receiver), ``pass_id``, ``spacecraft``
 station         ITRS offset (m) of station ``owner`` from the catalog, ``info['axis']`` x/y/z (linear)
 media           offset of the media scale from ``setup.media_scale`` (linear, exact)
 ==============  =================================================================================
@@ -245,7 +246,8 @@ class TrackingProblem:
         for i, p in enumerate(params):
             if p.kind == "bias":
                 sel = self._bias_rows(p, rows)
-                H_lin[sel, i] = ev.partials.get("bias", np.ones((m, 1)))[sel, 0] / ev.to_los[sel]
+                per = np.where(rows["unit"].to_numpy()[sel] == "rad", 1.0, ev.to_los[sel])  # angles stay angles
+                H_lin[sel, i] = ev.partials.get("bias", np.ones((m, 1)))[sel, 0] / per
             elif p.kind == "station" and f"station:{p.owner}" in ev.partials:
                 H_lin[:, i] = ev.partials[f"station:{p.owner}"][:, "xyz".index(p.info["axis"])]
             elif p.kind == "media" and "media_scale" in ev.partials:

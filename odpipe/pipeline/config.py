@@ -75,6 +75,22 @@ def _recognised(path: Path, readers: tuple[str, ...], what: str) -> str | None:
                                                 "no reader recognises it)")
 
 
+def _data_sigmas(value: dict) -> list[tuple[str, str]]:
+    """Check: each data_sigma entry a positive number, or for an angle observable a positive angle with its unit."""
+    from odpipe.od.arc import sigma_value  # the fit's own reading of the entries (imports numerics: only when checked)
+
+    out = []
+    for key, v in value.items():
+        try:
+            s = sigma_value(key, v)
+        except ValueError as exc:
+            out.append((f".{key}", str(exc)))
+            continue
+        if not (s > 0 and np.isfinite(s)):
+            out.append((f".{key}", f"{v!r} must be positive and finite"))
+    return out
+
+
 def _files_of(readers, what: str):
     """Check: a path (or every path of a list) is a readable file of one of ``readers()``."""
     return lambda paths: [("", why) for p in (paths if isinstance(paths, list) else [paths])
@@ -209,8 +225,10 @@ class EstimationSection:
     sigma_velocity: float = checked(positive, default=1.0)  # m/s, a priori, per axis
     srp_scale_sigma: float | None = checked(positive, default=0.1)  # a priori sigma of the SRP scale (none: fixed)
     stochastic: StochasticSection | None = None  # Gauss-Markov RTN accelerations (none: off)
-    # LOS sigma (m, m/s) by "observable" or "observable:station" (the station's entry wins)
-    data_sigma: dict[str, float] = checked(positive, default_factory=lambda: {"range": 2.0, "doppler_2way": 1e-4})
+    # LOS sigma (m, m/s) by "observable" or "observable:station" (the station's entry wins); angle observables:
+    # the angle's own sigma, a number in rad or a string with its unit ("0.01 deg", "36 arcsec", "1e-4 rad")
+    data_sigma: dict[str, float | str] = checked(lambda v: _data_sigmas(v),
+                                                 default_factory=lambda: {"range": 2.0, "doppler_2way": 1e-4})
     range_bias_sigma: float | None = checked(positive, default=5.0)  # m, a per-pass range bias (none: not estimated)
     # one-way Doppler's oscillator, estimated when set: sigmas of its fractional frequency offset y0 and drift
     # y1 (1/s) about the arc start, one pair for every band it drives (a priori 0: the rows' reference)
