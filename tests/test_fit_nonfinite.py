@@ -71,7 +71,7 @@ def test_non_finite_rows_are_flagged_and_the_fit_equals_the_fit_without_them(cas
     assert all(h["nonfinite"] == len(nonfinite) for h in sol.history)
     post = sol.residuals["postfit"].to_numpy()
     np.testing.assert_allclose(post[keep], clean.residuals["postfit"].to_numpy(), rtol=0, atol=1e-6 * 2.0)
-    assert np.isfinite(sol.history[-1]["postfit_rms"])
+    assert np.isfinite(sol.history[-1]["postfit_rms"]) and np.isnan(post[~keep]).all()
 
 
 def test_the_reason_has_a_table_flag():

@@ -274,8 +274,9 @@ def fit(problem: Problem, obs: Observations, t_start: float, t_end: float,
             raise NothingToFit(_nothing_left(ps.flags, it))
         postfit = np.full(obs.time.size, np.nan)
         for k, rows, H, y in ps.blocks:
-            with np.errstate(invalid="ignore"):   # non-finite rows stay NaN
+            with np.errstate(invalid="ignore"):
                 postfit[rows] = y - H @ dx[k]
+        postfit[(ps.flags & NONFINITE) != 0] = np.nan
         rms = float(np.sqrt(np.mean((postfit[ok] / sig_row[ok]) ** 2)))
         P0 = _gaussian(ps, *ps.smoothed[0]).P
         if np.all(np.diag(P0)[:n_est] >= reg.sigma[:n_est] ** 2 * (1.0 - NO_INFORMATION)):
