@@ -133,13 +133,12 @@ def _parse_card(text: str, fitsig: float, path, line: int) -> Card:
     scope = {}
     rest = m["scope"]
     pos = 0
-    for sm in _SCOPE.finditer(rest):
-        if sm.start() != pos:
-            break
+    # one anchored match per clause: finditer would retry from every position (quadratic on a long word)
+    while sm := _SCOPE.match(rest, pos):
         scope[sm["key"]] = sm["arg"]
         pos = sm.end()
     if rest[pos:].strip():
-        raise ParseError(path, f"unreadable scope {rest[pos:].strip()!r}", line=line)
+        raise ParseError(path, f"unreadable scope {rest[pos:].strip()[:60]!r}", line=line)
     start = _parse_time(scope["FROM"], path, line) if "FROM" in scope else _OPEN_START
     end = _parse_time(scope["TO"], path, line) if "TO" in scope else _OPEN_END
     if series == "NRMPOW" and ("FROM" not in scope or "TO" not in scope):

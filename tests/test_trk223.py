@@ -137,3 +137,14 @@ def test_empty_or_not_ascii_is_a_parse_error_in_both_modes(tmp_path, text):
     for mode in ("raise", "report"):
         with pytest.raises(ParseError):
             read_trk223(p, errors=mode, report=ParseReport())
+
+
+def test_long_word_in_the_scope_is_refused_in_linear_time(tmp_path):
+    # found by benchmarks/bench_fuzz.py: a 200,000-letter word after a card hung the scope parser (quadratic)
+    import time
+    p = tmp_path / "long.tro"
+    p.write_text(_CARD[:-2] + " " + "A" * 200_000 + ").\n")
+    t = time.process_time()
+    with pytest.raises(ParseError, match="unreadable scope"):
+        read_trk223(p)
+    assert time.process_time() - t < 1.0

@@ -123,7 +123,8 @@ def _common(r: np.ndarray, fc: int) -> dict:
         cols["transponder_ratio"] = np.where(den > 0, r["scft_transpd_turn_num"] / np.where(den > 0, den, 1),
                                              np.nan)
     if "cnt_time" in names:
-        cols["count_time"] = r["cnt_time"].astype(np.float64)
+        with np.errstate(invalid="ignore"):  # a signalling-NaN bit pattern stays NaN, no warning
+            cols["count_time"] = r["cnt_time"].astype(np.float64)
     cols["tag"] = "transmit" if layout.CLASS_OF_FORMAT[fc] == "C123" else "receive"
     cols["format_code"] = np.int64(fc)
     return cols
