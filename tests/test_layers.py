@@ -81,9 +81,9 @@ def layer_of(module: str) -> int | None:
     best, index = "", None
     for i, (_, packages) in enumerate(LAYERS):
         for pkg in packages:
-            exact_root = pkg == "odpipe" and module == "odpipe"
-            if (exact_root or (pkg != "odpipe" and (module == pkg or module.startswith(pkg + "."))))\
-                    and len(pkg) > len(best):
+            # "odpipe" places the package's own __init__ only, never its subpackages
+            inside = module == pkg or (pkg != "odpipe" and module.startswith(pkg + "."))
+            if inside and len(pkg) > len(best):
                 best, index = pkg, i
     if index is None:
         raise LookupError(f"{module} is in no layer: add its package to LAYERS in tests/test_layers.py")
