@@ -49,13 +49,15 @@ from odpipe.environment.gravity import read_gravity  # noqa: E402
 from odpipe.measurements import MeasurementSetup  # noqa: E402
 import odpipe.od.arc as arc_module  # noqa: E402
 from odpipe.od import ArcSetup, TrackingPlan, fit_arc, simulate_tracking  # noqa: E402
-from odpipe.od.simulate import libration_arc  # noqa: E402
 from odpipe.time import utc_to_tdb  # noqa: E402
 
 ROOT = Path(__file__).resolve().parents[1]
 DATA = Path(os.environ.get("ODPIPE_SHARED_DATA", ROOT.parent / "shared" / "data"))
 sys.path.insert(0, str(ROOT.parent / "shared" / "peers" / "bench"))
 import common as peers  # noqa: E402
+
+sys.path.insert(0, str(ROOT / "tests"))
+from libration_case import libration_arc  # noqa: E402
 
 
 def case():

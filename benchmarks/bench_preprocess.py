@@ -8,7 +8,7 @@ import numpy as np
 
 from odpipe.preprocess.compress import compress
 from odpipe.preprocess.edit import edit
-from odpipe.preprocess.passes import assign_passes
+from odpipe.tracking.passes import assign_passes
 from parsers.table import build
 
 N = 1_000_000

@@ -3,7 +3,7 @@
 import numpy as np
 import pytest
 
-from odpipe.dynamics.chebyshev import evaluate
+from odpipe.numerics.chebyshev import evaluate
 from odpipe.dynamics.forces import (Cylinder, EmpiricalRTN, FiniteBurn, ForceModel, Plate, PointMasses,
                                     Relativity, SolarRadiationPressure, SphericalHarmonics,
                                     compile_model)
@@ -124,7 +124,7 @@ def test_rotation_tables_match_direct_calls():
     from odpipe.frames.earth import gcrs_to_itrs
     from odpipe.frames.moon import moon_pa_to_icrf
 
-    from odpipe.dynamics.chebyshev import fit_channel, stack_channels
+    from odpipe.numerics.chebyshev import fit_channel, stack_channels
     from odpipe.dynamics.forces import ROTATION_GRID
 
     t1 = T0 + 3 * 86400.0

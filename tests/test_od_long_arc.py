@@ -1,4 +1,4 @@
-"""Reweighting and gentle editing re-validated on a 14-day libration arc (``od.simulate.libration_arc``).
+"""Reweighting and gentle editing re-validated on a 14-day libration arc (``tests/libration_case.py``).
 
 ARTEMIS-P2-like L1 orbit, two station-keeping burns and an attitude burn (dV and firing
 epoch estimated), RTN accelerations in 8-h batches, per-pass range biases: 7,620 rows,
@@ -16,7 +16,7 @@ import numpy as np
 import pytest
 
 from odpipe.od import fit_arc
-from odpipe.od.simulate import libration_arc
+from libration_case import libration_arc
 
 
 @pytest.fixture(scope="module")

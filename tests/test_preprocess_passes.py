@@ -5,8 +5,8 @@ import pandas as pd
 import pytest
 
 from odpipe.preprocess.flags import Flag, names
-from odpipe.preprocess.passes import assign_passes, pass_summary
-from odpipe.preprocess.timetags import interval_bounds, tag_epoch
+from odpipe.tracking.passes import assign_passes, pass_summary
+from odpipe.tracking.timetags import interval_bounds, tag_epoch
 from parsers.table import build, empty_ramps
 
 T0 = np.datetime64("2012-04-09T00:00:00", "ns")

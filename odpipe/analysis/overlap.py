@@ -164,7 +164,7 @@ def consecutive_overlaps(trajs: dict, order, out, label: str, title: str = "", s
 
     Returns (table, [png paths]), or (None, []) when no consecutive arcs overlap.
     """
-    from odpipe.products.atomic import write_text
+    from parsers.atomic import write_text
 
     names = list(order)
     pairs = [(a, b) for a, b in zip(names[:-1], names[1:]) if trajs[a].t1 > trajs[b].t0]
@@ -210,7 +210,7 @@ def plot_overlaps(summary: pd.DataFrame, path, kind: str = "pos", title: str = "
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
 
-    from odpipe.products.atomic import save_figure
+    from parsers.atomic import save_figure
 
     rows = summary[~summary["overlap"].isin(["mean", "std"])]
     labels = ["Radial", "In-track", "Cross-track", "3D RMS"]

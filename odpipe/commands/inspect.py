@@ -11,9 +11,10 @@ from parsers import formats
 from parsers.errors import ParseReport
 from parsers.table import TrackingData
 from odpipe.errors import Exit, describe
-from odpipe.preprocess import ramp_segments, store
+from odpipe.preprocess import store
+from odpipe.tracking import ramp_segments
 from odpipe.preprocess.edit import duplicates, invalid
-from odpipe.preprocess.passes import assign_passes
+from odpipe.tracking.passes import assign_passes
 
 NAME = "inspect"
 HELP = "detect a file's format and summarize its contents and anomalies"

@@ -29,7 +29,7 @@ from typing import Callable, Sequence
 
 import numpy as np
 
-from odpipe.dynamics.chebyshev import fit_channel, stack_channels
+from odpipe.numerics.chebyshev import fit_channel, stack_channels
 from odpipe.dynamics.harmonics import by_order, recursion_factors
 from odpipe.dynamics.srp import CYLINDER, P_SUN_1AU, PLATE, SUN_CYLINDER, SUN_PLATE
 from odpipe.environment.gravity import GravityField

@@ -12,7 +12,7 @@ import numpy as np
 from numba import njit, types
 from numba.extending import overload
 
-from odpipe.dynamics.chebyshev import evaluate
+from odpipe.numerics.chebyshev import evaluate
 from odpipe.dynamics.dop853 import derivative
 from odpipe.dynamics.drag import drag_acceleration
 from odpipe.dynamics.forces import PARAM_CD, PARAM_EMP, PARAM_RHO_D, PARAM_RHO_S, PARAM_SCALE

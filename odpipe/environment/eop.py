@@ -22,7 +22,7 @@ import numpy as np
 
 import astropy_iers_data
 from odpipe.environment.eop_tides import ocean_tide_eop
-from odpipe.environment.interpolation import lagrange4_uniform, on_uniform_grid
+from odpipe.numerics.interpolation import lagrange4_uniform, on_uniform_grid
 from odpipe.time.leap_seconds import NS_PER_DAY, tai_minus_utc_ns
 from odpipe.time.scales import as_utc_ns
 

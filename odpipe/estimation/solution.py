@@ -66,7 +66,7 @@ class Solution:
 
     def save(self, path) -> None:
         """Write atomically to one ``.npz`` (arrays, residual columns, history as JSON)."""
-        from odpipe.products.atomic import write_bytes
+        from parsers.atomic import write_bytes
 
         meta = {"names": list(self.names), "history": self.history,
                 "converged": self.converged, "inputs": self.inputs}

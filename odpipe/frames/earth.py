@@ -18,7 +18,7 @@ import erfa
 import numpy as np
 
 from odpipe.environment.eop import EOPValues, eop_at
-from odpipe.environment.interpolation import on_uniform_grid
+from odpipe.numerics.interpolation import on_uniform_grid
 from odpipe.frames.epochs import utc_and_tt
 from odpipe.frames.rotations import frame_rotation
 from odpipe.time.leap_seconds import NS_PER_DAY, tai_minus_utc_ns

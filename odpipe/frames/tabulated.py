@@ -4,7 +4,7 @@ The measurement models ask for the full IAU 2006/2000A rotation with EOP at ever
 light-time event of every row (several times per row and iteration); over an arc
 the nine matrix elements are smooth (daily rotation, nutation, interpolated EOP),
 so they are fitted once on hourly segments of degree 12
-(:func:`odpipe.dynamics.chebyshev.fit_channel`) and evaluated from the table.
+(:func:`odpipe.numerics.chebyshev.fit_channel`) and evaluated from the table.
 The table reproduces the full model to < 1e-12 rad (6 micrometres at a station;
 tested), far below the model's own EOP-interpolation jitter.
 """
@@ -14,7 +14,7 @@ from __future__ import annotations
 import numpy as np
 from numba import njit
 
-from odpipe.dynamics.chebyshev import evaluate, fit_channel
+from odpipe.numerics.chebyshev import evaluate, fit_channel
 
 SEGMENT_S, DEGREE = 3600.0, 12
 

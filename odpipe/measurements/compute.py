@@ -51,7 +51,7 @@ import pandas as pd
 
 from odpipe.environment.ephemeris import SpanEphemeris
 from odpipe.frames.tabulated import TabulatedRotation
-from odpipe.preprocess.timetags import interval_bounds
+from odpipe.tracking.timetags import interval_bounds
 
 from . import angles, crosslink, dsn, instantaneous, refraction
 from .bands import C_LIGHT, ONE_WAY_SCALE, band_name, range_unit_factor, turnaround_ratio

@@ -39,9 +39,9 @@ from odpipe.measurements.bands import C_LIGHT, range_unit_factor
 from odpipe.media import mendes_pavlis, saastamoinen
 from odpipe.media.model import MediaModel
 from odpipe.media.smoothing import smooth_by_group
-from odpipe.preprocess import ramp_segments
-from odpipe.preprocess.passes import assign_passes
-from odpipe.preprocess.timetags import interval_bounds
+from odpipe.tracking import ramp_segments
+from odpipe.tracking.passes import assign_passes
+from odpipe.tracking.timetags import interval_bounds
 
 # nominal DSN sky frequencies (Hz) when a row has no usable frequency
 NOMINAL_HZ = {("up", "S"): 2.115e9, ("up", "X"): 7.16e9, ("up", "KA"): 34.3e9,

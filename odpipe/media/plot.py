@@ -10,7 +10,7 @@ matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 import pandas as pd  # noqa: E402
 
-from odpipe.products.atomic import save_figure  # noqa: E402
+from parsers.atomic import save_figure  # noqa: E402
 
 
 def plot_pass_delays(table: pd.DataFrame, pass_id: int, path) -> Path:

@@ -46,7 +46,7 @@ from odpipe.measurements.bands import C_LIGHT
 from odpipe.preprocess.compress import compress
 from odpipe.preprocess.edit import EditConfig, edit
 from odpipe.preprocess.flags import Flag, set_flag
-from odpipe.preprocess.timetags import interval_bounds
+from odpipe.tracking.timetags import interval_bounds
 from odpipe.time import utc_to_tdb
 
 

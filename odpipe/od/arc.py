@@ -27,7 +27,7 @@ from odpipe.estimation.registry import GaussMarkov, ParameterRegistry
 from odpipe.measurements import MeasurementSetup
 from odpipe.measurements.compute import spanning
 from odpipe.preprocess.flags import Flag
-from odpipe.preprocess.timetags import interval_bounds
+from odpipe.tracking.timetags import interval_bounds
 from odpipe.time import utc_to_tdb
 
 from .problem import TrackingProblem

@@ -30,11 +30,11 @@ from dataclasses import dataclass, field
 import numpy as np
 import pandas as pd
 
-from odpipe.preprocess import ramp_segments
 from odpipe.preprocess.flags import Flag
 from odpipe.preprocess.noise import third_difference_scatter
-from odpipe.preprocess.passes import assign_passes
-from odpipe.preprocess.timetags import interval_bounds, tag_epoch
+from odpipe.tracking import ramp_segments
+from odpipe.tracking.passes import assign_passes
+from odpipe.tracking.timetags import interval_bounds, tag_epoch
 from parsers.table import COLUMNS
 
 AVERAGED = ("range_rate", "sst_doppler")

@@ -25,10 +25,10 @@ import numpy as np
 import pandas as pd
 
 from odpipe.preprocess.flags import Flag, set_flag, summary
-from odpipe.preprocess.passes import LINK, assign_passes, link_id
-from odpipe.preprocess.ramp_segments import store
 from odpipe.preprocess.robust import gross, outliers, spikes
 from odpipe.preprocess.uplink import in_acquisition
+from odpipe.tracking.passes import LINK, assign_passes, link_id
+from odpipe.tracking.ramp_segments import store
 
 log = logging.getLogger(__name__)
 

@@ -21,7 +21,7 @@ from __future__ import annotations
 import numpy as np
 import pandas as pd
 
-from odpipe.preprocess.timetags import interval_bounds
+from odpipe.tracking.timetags import interval_bounds
 from parsers.ramps import RampStore
 
 UPLINK_OBSERVABLES = ("doppler_2way", "doppler_3way", "range")

@@ -164,7 +164,7 @@ def _two_way_receive_freq(rows: pd.DataFrame, store: RampStore | None) -> np.nda
     """Mean received frequency (Hz) over each count interval of two/three-way Doppler rows."""
     if rows.empty:
         return np.empty(0)
-    from odpipe.preprocess.timetags import interval_bounds
+    from odpipe.tracking.timetags import interval_bounds
 
     m2 = rows["transponder_ratio"].to_numpy(float)
     m2 = np.where(np.isfinite(m2), m2, turnaround_ratio(rows["band_up"].to_numpy(object),

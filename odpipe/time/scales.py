@@ -18,7 +18,7 @@ from __future__ import annotations
 import erfa
 import numpy as np
 
-from odpipe.environment.interpolation import lagrange4_uniform
+from odpipe.numerics.interpolation import lagrange4_uniform
 from odpipe.time.leap_seconds import NS_PER_DAY, NS_PER_S, tai_minus_utc_ns, utc_ns_from_tai_ns
 
 TT_MINUS_TAI_NS = 32_184_000_000

@@ -12,8 +12,8 @@ from __future__ import annotations
 import numpy as np
 import pandas as pd
 
-from odpipe.preprocess import ramp_segments
-from odpipe.preprocess.timetags import interval_bounds
+from odpipe.tracking import ramp_segments
+from odpipe.tracking.timetags import interval_bounds
 
 LINK = ["station_tx", "station_rx", "spacecraft", "observable", "band_up", "band_down"]
 
