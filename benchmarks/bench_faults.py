@@ -83,7 +83,7 @@ def _pgid(pid: int) -> int | None:
 
 def finished(out: Path) -> dict:
     """arc -> its current manifest's finish time; asserts that every ``current`` verifies."""
-    from odpipe.runs import rundir
+    from odpipe.operations import rundir
 
     done = {}
     for root in sorted(p for p in out.iterdir() if p.is_dir()):
@@ -134,7 +134,7 @@ def check_night(folder: Path, arcs: int) -> dict:
     """The end state: every arc once, every product parsing, the report complete, no temporaries."""
     import pandas as pd
 
-    from odpipe.runs import rundir
+    from odpipe.operations import rundir
 
     out = folder / "out"
     counts = {"products": 0, "abandoned": 0}

@@ -9,9 +9,9 @@ from pathlib import Path
 
 import numpy as np
 
-from odpipe.products.ephemeris import EphemerisSegment
+from odpipe.products.segments import EphemerisSegment
 from odpipe.products.oem import write_oem
-from odpipe.runs import rundir
+from odpipe.operations import rundir
 
 
 def run_arc(config: Path) -> dict:

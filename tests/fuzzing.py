@@ -181,7 +181,7 @@ def _plan_seeds(data: Path) -> list[bytes]:
 
 
 def _oem_seeds(data: Path) -> list[bytes]:
-    from odpipe.products.ephemeris import EphemerisSegment
+    from odpipe.products.segments import EphemerisSegment
     from odpipe.products.oem import format_oem
     t = np.arange(4) * 60.0 + 3.9e8
     states = np.column_stack([7e6 + t * 0, t * 0 + 1e3, t * 0, t * 0, t * 0 + 7.5e3, t * 0 + 1.0])

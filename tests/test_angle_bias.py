@@ -100,7 +100,7 @@ def test_angle_sigmas_carry_their_unit():
 
 def test_run_config_takes_angle_sigmas_with_units(tmp_path):
     from odpipe.pipeline.config import load_config
-    from odpipe.runs.schema import ConfigError
+    from odpipe.operations.schema import ConfigError
     from tests.heo_case import write_config
 
     from odpipe.preprocess import store

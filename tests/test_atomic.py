@@ -1,4 +1,4 @@
-"""The one atomic writer (parsers.atomic) and the clean-up of killed runs' attempt folders (odpipe.runs.rundir)."""
+"""The one atomic writer (parsers.atomic) and the clean-up of killed runs' attempt folders (odpipe.operations.rundir)."""
 
 import json
 import os
@@ -14,7 +14,7 @@ import pandas as pd
 import pytest
 
 from parsers import atomic
-from odpipe.runs import rundir
+from odpipe.operations import rundir
 
 ROOT = Path(__file__).resolve().parents[1]
 
@@ -175,7 +175,7 @@ _IN_PLACE = [re.compile(p) for p in (
 
 def test_every_product_table_plot_and_report_goes_through_the_atomic_writer():
     """No module of odpipe, parsers or runs writes a file in place or has its own atomic write."""
-    allowed = {"parsers/atomic.py", "odpipe/runs/rundir.py"}   # the writer itself; the ``current`` link switch
+    allowed = {"parsers/atomic.py", "odpipe/operations/rundir.py"}   # the writer itself; the ``current`` link switch
     found = []
     for folder in ("odpipe", "parsers", "runs"):
         for f in sorted((ROOT / folder).rglob("*.py")):

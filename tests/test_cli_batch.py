@@ -8,7 +8,7 @@ from pathlib import Path
 from odpipe.cli import main
 from odpipe.pipeline import setup as build
 from odpipe.pipeline.config import load_config
-from odpipe.runs import rundir
+from odpipe.operations import rundir
 
 TRACKING = Path(__file__).resolve().parents[1] / "fixtures" / "trk234" / "sample.tnf"
 

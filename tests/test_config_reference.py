@@ -6,7 +6,7 @@ from pathlib import Path
 
 from odpipe.cli import main
 from odpipe.pipeline.config import RunConfig, reference
-from odpipe.runs.reference import field_comments, sections
+from odpipe.operations.reference import field_comments, sections
 
 ROOT = Path(__file__).resolve().parents[1]
 

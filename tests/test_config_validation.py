@@ -8,7 +8,7 @@ import pytest
 
 from odpipe.cli import main
 from odpipe.pipeline.config import load_config
-from odpipe.runs.schema import ConfigError, key_line
+from odpipe.operations.schema import ConfigError, key_line
 
 TRACKING = Path(__file__).resolve().parents[1] / "fixtures" / "trk234" / "sample.tnf"  # a TRK-2-34 file
 

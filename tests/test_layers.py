@@ -32,7 +32,7 @@ LAYERS = (
     ("preprocess", ("odpipe.preprocess",)),
     ("estimation", ("odpipe.estimation",)),
     ("orbit determination and analysis", ("odpipe.od", "odpipe.analysis")),
-    ("products and run bookkeeping", ("odpipe.products", "odpipe.runs")),
+    ("products and run bookkeeping", ("odpipe.products", "odpipe.operations")),
     ("pipeline, simulator and studies", ("odpipe.pipeline", "odpipe.simulate", "odpipe.liaison")),
     ("commands", ("odpipe.commands", "odpipe.cli", "odpipe.api")),
 )

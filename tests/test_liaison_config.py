@@ -7,7 +7,7 @@ import re
 import pytest
 
 from odpipe.liaison.config import KEYS, load_config
-from odpipe.runs.schema import ConfigError
+from odpipe.operations.schema import ConfigError
 
 RUNS = Path(__file__).parents[1] / "runs"
 

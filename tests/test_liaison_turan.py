@@ -18,7 +18,7 @@ from scipy.stats import chi2
 
 from odpipe.liaison.config import load_config
 from odpipe.analysis.montecarlo import monte_carlo
-from odpipe.liaison.crosslink import RANGE, RANGE_RATE
+from odpipe.liaison.crtbp_problem import RANGE, RANGE_RATE
 from odpipe.liaison.orbits import halo_by_period, keplerian_orbit
 from odpipe.liaison.pair import CrosslinkPair
 from odpipe.liaison.turan import formations, log_ratios, observability_row, orbits, units

@@ -15,7 +15,7 @@ from odpipe.frames.earth import itrs_to_gcrs
 from odpipe.measurements.bands import C_LIGHT
 from odpipe.pipeline.geometry import add_geometry, load_trajectory
 from odpipe.preprocess import store
-from odpipe.products.ephemeris import EphemerisSegment
+from odpipe.products.segments import EphemerisSegment
 from odpipe.products.oem import write_oem
 from odpipe.products.spk import write_spk
 from odpipe.pipeline.setup import tdb

@@ -5,7 +5,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from odpipe.products.ephemeris import EphemerisSegment
+from odpipe.products.segments import EphemerisSegment
 from odpipe.products.oem import format_oem
 from parsers import ParseError, ParseReport, oem
 

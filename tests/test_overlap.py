@@ -95,7 +95,7 @@ def test_arc_schedules_follow_the_artemis_strategy():
 
 def test_overlap_command_on_oem_products(tmp_path):
     from odpipe.cli import main
-    from odpipe.products.ephemeris import EphemerisSegment
+    from odpipe.products.segments import EphemerisSegment
     from odpipe.products.oem import write_oem
 
     day = 86400.0
@@ -132,7 +132,7 @@ def test_oem_trajectory_keeps_its_centre_for_the_measurement_models(tmp_path):
     barycentric state); without the centre a GRAIL product was evaluated as if about the SSB."""
     from odpipe.analysis.overlap import oem_trajectory
     from odpipe.measurements.nodes import SpacecraftNode
-    from odpipe.products.ephemeris import EphemerisSegment
+    from odpipe.products.segments import EphemerisSegment
     from odpipe.products.oem import write_oem
     from odpipe.environment.ephemeris import Ephemeris
 

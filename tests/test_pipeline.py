@@ -62,7 +62,7 @@ def test_unchanged_arc_is_skipped_and_failed_rerun_keeps_products(case):
 def test_next_arc_starts_from_this_arcs_oem(case):
     """A nightly chain: the a priori of the next arc is this arc's OEM state; batch runs this arc first."""
     from odpipe.commands.batch import night_report, starts_from
-    from odpipe.runs.batch import ArcOutcome
+    from odpipe.operations.nightly import ArcOutcome
     from odpipe.pipeline.config import load_config
     from odpipe.pipeline.setup import initial_state, tdb
     from odpipe.time import tdb_to_utc

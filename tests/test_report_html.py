@@ -23,7 +23,7 @@ from odpipe import __version__
 from odpipe.analysis import maneuvers as maneuver_report
 from odpipe.analysis.overlap import Overlap, report_tables as overlap_tables, summarize
 from odpipe.pipeline.run import run_config
-from odpipe.runs.report import Section, render, utc_iso
+from odpipe.operations.report import Section, render, utc_iso
 from parsers import oem
 
 START, END = "2003-06-03T00:00:00", "2003-06-04T06:00:00"
@@ -100,7 +100,7 @@ def test_run_report_keeps_the_rules(run):
 
 def test_night_report_keeps_the_rules(run):
     from odpipe.commands.batch import night_report
-    from odpipe.runs.batch import ArcOutcome
+    from odpipe.operations.nightly import ArcOutcome
 
     tmp, _ = run
     page = night_report(tmp / "night", [tmp / "arc.toml"], [ArcOutcome(str(tmp / "arc.toml"), "complete", 1.0)])

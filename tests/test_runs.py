@@ -12,10 +12,10 @@ from pathlib import Path
 import pandas as pd
 import pytest
 
-from odpipe.runs import rundir
-from odpipe.runs.batch import dependency_order, night_summary, run_batch
-from odpipe.runs.report import Section, write_report
-from odpipe.runs.schema import ConfigError, load
+from odpipe.operations import rundir
+from odpipe.operations.nightly import dependency_order, night_summary, run_batch
+from odpipe.operations.report import Section, write_report
+from odpipe.operations.schema import ConfigError, load
 
 ROOT = Path(__file__).resolve().parents[1]
 
@@ -138,7 +138,7 @@ def test_chained_arcs_run_after_their_source_and_not_after_a_failure(tmp_path, m
 
 def test_batch_killed_midway_resumes_without_redoing_arcs(tmp_path, monkeypatch):
     configs = _arcs(tmp_path, 5, 2.0)
-    script = ("import sys; from pathlib import Path; from odpipe.runs.batch import run_batch;"
+    script = ("import sys; from pathlib import Path; from odpipe.operations.nightly import run_batch;"
               "from tests.batch_job import run_arc;"
               "run_batch([Path(p) for p in sys.argv[1:]], run_arc, workers=1)")
     env = dict(os.environ, PYTHONPATH=str(ROOT))

@@ -31,7 +31,7 @@ from odpipe.preprocess import store
 from odpipe.preprocess.compress import compress
 from odpipe.preprocess.edit import EditConfig, edit
 from odpipe.preprocess.flags import Flag
-from odpipe.products.ephemeris import EphemerisSegment
+from odpipe.products.segments import EphemerisSegment
 from odpipe.products.oem import write_oem
 from odpipe.time import utc_to_tdb
 from parsers.trk223 import read_trk223

@@ -7,8 +7,8 @@ from pathlib import Path
 
 from odpipe.errors import Exit, describe
 from odpipe.pipeline.config import RunSection, load_config
-from odpipe.runs.batch import load_batch, night_summary, run_batch
-from odpipe.runs.schema import load, read_toml
+from odpipe.operations.nightly import load_batch, night_summary, run_batch
+from odpipe.operations.schema import load, read_toml
 
 NAME = "batch"
 HELP = ("run many arcs (a nightly batch config listing arc configs) in parallel; skips arcs whose config, "
@@ -67,7 +67,7 @@ def night_report(out: Path, arcs: list[Path], outcomes, overlap_arcs: list[Path]
     from odpipe.pipeline.setup import tdb
     from odpipe.products import residuals
     from odpipe.products.atomic import write_csv
-    from odpipe.runs.report import Section, write_report
+    from odpipe.operations.report import Section, write_report
 
     out.mkdir(parents=True, exist_ok=True)
     status = {Path(o.config).resolve(): o for o in outcomes}

@@ -20,7 +20,7 @@ def check_case(path: Path) -> None:
     """ConfigError naming the case file and key when :func:`odpipe.simulate.case.load` cannot read it."""
     import tomllib
 
-    from odpipe.runs.schema import ConfigError
+    from odpipe.operations.schema import ConfigError
     from odpipe.simulate.case import load
 
     try:

@@ -22,7 +22,7 @@ import pandas as pd
 from odpipe.analysis.montecarlo import monte_carlo, rms_over_runs, rss
 from odpipe.dynamics.crtbp import EarthMoonUnits
 
-from .crosslink import RANGE, RANGE_RATE
+from .crtbp_problem import RANGE, RANGE_RATE
 from .orbits import halo_by_period, keplerian_orbit
 from .pair import CrosslinkPair
 from .report import plot_convergence, write_markdown, write_table

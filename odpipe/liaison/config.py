@@ -14,7 +14,7 @@ from __future__ import annotations
 
 from pathlib import Path
 
-from odpipe.runs.schema import ConfigError, Problem, read_toml, readable
+from odpipe.operations.schema import ConfigError, Problem, read_toml, readable
 
 ANY = "any"  # a value, or a table of any keys (reference figures, names chosen by the configuration)
 _CASE = {"liaison_gap_h": ANY, "ground_gap_h": ANY, "ground_offset_h": ANY}

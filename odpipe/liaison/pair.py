@@ -18,7 +18,7 @@ from odpipe.dynamics.crtbp import EarthMoonUnits
 from odpipe.estimation.fit import FitOptions, Observations, fit
 from odpipe.estimation.registry import ParameterRegistry
 
-from .crosslink import RANGE, CrosslinkProblem, crosslink_rows, flow, state_scale
+from .crtbp_problem import RANGE, CrosslinkProblem, crosslink_rows, flow, state_scale
 
 
 @dataclass(frozen=True)

@@ -24,7 +24,7 @@ from odpipe.analysis.montecarlo import monte_carlo, rms_over_runs, rss
 from odpipe.analysis.observability import gramian, observability_measures, snr_ratio
 from odpipe.dynamics.crtbp import jacobi_constant
 
-from .crosslink import RANGE, RANGE_RATE, units_from_mu
+from .crtbp_problem import RANGE, RANGE_RATE, units_from_mu
 from .orbits import halo_by_period, halo_start, keplerian_orbit
 from .pair import CrosslinkPair
 from .report import plot_convergence, write_markdown, write_table

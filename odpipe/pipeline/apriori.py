@@ -22,7 +22,7 @@ from odpipe.od.apriori import AprioriResult, determine_orbit, doppler_rows
 from odpipe.pipeline.config import DopplerAprioriSection, RunConfig
 from odpipe.pipeline.ingest import ingest
 from odpipe.pipeline.setup import station_catalog
-from odpipe.runs.schema import ConfigError
+from odpipe.operations.schema import ConfigError
 from odpipe.time import tdb_to_utc
 
 FRAMES = {"moon": moon_pa_to_icrf}  # central body -> its body-fixed (PA) frame to ICRF, for the grid search

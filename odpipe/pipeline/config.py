@@ -6,7 +6,7 @@ Unknown keys, wrong types, missing required keys and bad values (a time that
 does not exist, an end before the start, a sigma or step that is not positive
 and finite, a data file that is missing, unreadable or not recognised, a run
 name that would leave the output folder) are found at load, all of them at
-once: one :class:`odpipe.runs.schema.ConfigError` names the file and each key
+once: one :class:`odpipe.operations.schema.ConfigError` names the file and each key
 with its line.
 """
 
@@ -23,7 +23,7 @@ from typing import Literal
 
 import numpy as np
 
-from odpipe.runs.schema import (at_least, between, checked, file_name, internal, load, positive, read_toml,
+from odpipe.operations.schema import (at_least, between, checked, file_name, internal, load, positive, read_toml,
                                 readable, readable_files)
 
 
@@ -293,6 +293,6 @@ def load_config(path) -> RunConfig:
 
 def reference() -> str:
     """The run configuration reference (Markdown), generated from the classes above."""
-    from odpipe.runs.reference import markdown
+    from odpipe.operations.reference import markdown
 
     return markdown(RunConfig, "Run configuration reference", skip=("path", "text"))

@@ -29,8 +29,8 @@ from odpipe.analysis import overlap
 from odpipe.pipeline.run import run_config
 from odpipe.products.atomic import write_text
 from odpipe.products.spk import SpkTrajectory
-from odpipe.runs.batch import night_summary, run_batch
-from odpipe.runs.report import Section, utc_iso, write_report
+from odpipe.operations.nightly import night_summary, run_batch
+from odpipe.operations.report import Section, utc_iso, write_report
 from odpipe.simulate.case import load as load_case
 from odpipe.simulate.run import run_case
 from odpipe.time import tdb_to_utc, utc_to_tdb

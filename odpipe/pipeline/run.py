@@ -3,7 +3,7 @@
 ingest → geometry (a priori trajectory) → media calibration → Doppler
 compression → editing → iterated filter-smoother → products. Every product is
 written into a new attempt folder; the run becomes ``current`` only when all
-of them are there (:mod:`odpipe.runs.rundir`), so a failed or killed run
+of them are there (:mod:`odpipe.operations.rundir`), so a failed or killed run
 leaves the previous good products untouched. An arc whose config and input
 files are unchanged since its last complete run is skipped.
 """
@@ -29,16 +29,16 @@ from odpipe.pipeline import setup as build
 from odpipe.pipeline.config import RunConfig, load_config
 from odpipe.pipeline.geometry import add_geometry, apparent_itrs, median_round_trip
 from odpipe.pipeline.ingest import ingest
-from odpipe.pipeline.products import fitted_segments
+from odpipe.pipeline.fitted_trajectory import fitted_segments
 from odpipe.preprocess.compress import compress
 from odpipe.preprocess.edit import EditConfig, edit
 from odpipe.products import parameters, residuals
 from odpipe.products.atomic import write_parquet, write_text
 from odpipe.products.oem import write_oem
 from odpipe.products.spk import write_spk
-from odpipe.runs import rundir
-from odpipe.runs.schema import ConfigError
-from odpipe.runs.report import Section, write_report
+from odpipe.operations import rundir
+from odpipe.operations.schema import ConfigError
+from odpipe.operations.report import Section, write_report
 from odpipe.time import tdb_to_utc
 from parsers.ionex import read_ionex
 from parsers.trk223 import read_trk223

@@ -17,7 +17,7 @@ from odpipe.frames.local import rtn_matrix
 from odpipe.measurements import MeasurementSetup
 from odpipe.od.arc import ArcSetup, ManeuverPlan
 from odpipe.pipeline.config import RunConfig
-from odpipe.runs.schema import ConfigError
+from odpipe.operations.schema import ConfigError
 from odpipe.time import utc_to_tdb
 from parsers.maneuvers import read_plan
 

@@ -12,7 +12,7 @@ from datetime import datetime, timezone
 import numpy as np
 
 from odpipe.products.atomic import write_text
-from odpipe.products.ephemeris import EphemerisSegment
+from odpipe.products.segments import EphemerisSegment
 from odpipe.time import tdb_to_utc
 
 J2000_TDB = np.datetime64("2000-01-01T12:00:00", "ns")
@@ -21,7 +21,7 @@ _TRIL = np.tril_indices(6)
 
 def epoch_strings(t_tdb, time_system: str = "TDB") -> list[str]:
     """ISO calendar strings of TDB seconds past J2000, in TDB or UTC, rounded to the nearest µs (an
-    epoch on a whole µs reads back as the same double: see :func:`odpipe.pipeline.products.fitted_segments`)."""
+    epoch on a whole µs reads back as the same double: see :func:`odpipe.pipeline.fitted_trajectory.fitted_segments`)."""
     t_tdb = np.atleast_1d(np.asarray(t_tdb, dtype=float))
     if time_system == "TDB":
         # The TDB calendar has no leap seconds: plain arithmetic from J2000.

@@ -11,7 +11,7 @@ import numpy as np
 import spiceypy as sp
 
 from odpipe.products.atomic import atomic_path
-from odpipe.products.ephemeris import EphemerisSegment
+from odpipe.products.segments import EphemerisSegment
 
 # NAIF ids of the centres a segment may name.
 NAIF_IDS = {"ssb": 0, "sun": 10, "mercury": 199, "venus": 299, "earth": 399, "moon": 301, "emb": 3, "mars": 4,

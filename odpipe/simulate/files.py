@@ -22,7 +22,7 @@ import numpy as np
 import pandas as pd
 
 from odpipe.products.atomic import write_bytes, write_parquet, write_text
-from odpipe.products.ephemeris import EphemerisSegment
+from odpipe.products.segments import EphemerisSegment
 from odpipe.products.oem import write_oem
 from odpipe.products.spk import write_spk
 from odpipe.time import utc_to_doy

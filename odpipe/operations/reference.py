@@ -1,6 +1,6 @@
 """The configuration reference, generated from the schema dataclasses so it cannot drift.
 
-Each section is a dataclass (:mod:`odpipe.runs.schema` loads them); a key's description is the
+Each section is a dataclass (:mod:`odpipe.operations.schema` loads them); a key's description is the
 comment on its line in the class source, or the comment lines just above it; a section's description is
 its class docstring. ``odpipe reference`` prints the Markdown; ``docs/config.md`` is its output.
 """

@@ -3,7 +3,7 @@
 Each arc is a run configuration; ``run_one(config_path) -> dict`` runs it and
 returns at least ``{"status": "complete" | "skipped", ...}``. An arc whose
 products are complete and whose config and inputs are unchanged is skipped
-by ``run_one`` itself (see :func:`odpipe.runs.rundir.up_to_date`), so a
+by ``run_one`` itself (see :func:`odpipe.operations.rundir.up_to_date`), so a
 batch killed at any point is simply started again. An arc that starts from another
 arc's products (a nightly chain) runs after it, and is reported failed without being
 run when that arc failed. An arc whose configuration cannot be loaded is reported
@@ -21,7 +21,7 @@ from pathlib import Path
 from typing import Callable
 
 from odpipe.errors import describe
-from odpipe.runs.schema import checked, load, positive, read_toml
+from odpipe.operations.schema import checked, load, positive, read_toml
 
 _log = logging.getLogger(__name__)
 

@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from odpipe.products.ephemeris import EphemerisSegment
+from odpipe.products.segments import EphemerisSegment
 
 
 def product_epochs(a: float, b: float, step: float) -> np.ndarray:

@@ -1,0 +1,1 @@
+"""Operations: the configuration schema and its reference, run folders with manifests, reports, nightly batches."""

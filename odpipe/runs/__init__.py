@@ -1,1 +1,0 @@
-"""Runs: configuration files, run directories with manifests, reports, nightly batches."""
