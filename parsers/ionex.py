@@ -257,7 +257,11 @@ def _map(lines, i, label, grids, exponent, path):
 def _index(grid, value):
     """Index (or indices) of ``value`` on a regular grid; KeyError when off the grid."""
     step = grid[1] - grid[0] if grid.size > 1 else 1.0
-    k = np.rint((np.asarray(value, dtype=float) - grid[0]) / step).astype(int)
-    if np.any(k < 0) or np.any(k >= grid.size) or not np.allclose(grid[np.clip(k, 0, grid.size - 1)], value):
+    with np.errstate(over="ignore"):
+        f = np.rint((np.asarray(value, dtype=float) - grid[0]) / step)
+    if not np.all((f >= 0) & (f < grid.size)):  # (also before a cast of inf to int)
+        raise KeyError(f"{value}")
+    k = f.astype(int)
+    if not np.allclose(grid[k], value):
         raise KeyError(f"{value}")
     return k
