@@ -45,6 +45,9 @@ class ManeuverPlan:
     sigma_epoch: float | None = None
 
 
+DATA_SIGMA = {"range": 2.0, "doppler_2way": 1e-4}  # default data sigmas along the line of sight: m, m/s
+
+
 @dataclass
 class ArcSetup:
     """Everything one arc fit needs (SI units; times TDB s past J2000).
@@ -80,17 +83,17 @@ class ArcSetup:
     srp_scale_sigma: float | None = 0.1
     stochastic: GaussMarkov | None = None
     maneuvers: tuple = ()
-    data_sigma: dict = field(default_factory=lambda: {"range": 2.0, "doppler_2way": 1e-4})
+    data_sigma: dict = field(default_factory=lambda: dict(DATA_SIGMA))
     range_bias_sigma: float | None = 5.0
     angle_bias_sigma: float | None = None
     oscillator_sigma: tuple | None = None
     station_sigma: float | None = None
     media_sigma: float | None = None
-    edit_k: tuple = (np.inf, 10.0, 5.0)
-    max_iter: int = 10
-    reweight: bool = False
-    sigma_scale: tuple = (1.0,)
-    block: float = 600.0
+    edit_k: tuple = FitOptions.edit_k  # the fit's defaults have one home, FitOptions
+    max_iter: int = FitOptions.max_iter
+    reweight: bool = FitOptions.reweight
+    sigma_scale: tuple = FitOptions.sigma_scale
+    block: float = FitOptions.block
     lookback: float = 120.0
     growing_days: float | None = 2.0  # first span of the growing-arc start (None: fit the whole arc at once)
     tabulate_earth_rotation: bool = True

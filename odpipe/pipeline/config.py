@@ -23,6 +23,8 @@ from typing import Literal
 
 import numpy as np
 
+from odpipe.estimation.fit import FitOptions
+from odpipe.od.arc import DATA_SIGMA, ArcSetup
 from odpipe.operations.schema import (at_least, between, checked, file_name, internal, load, positive, read_toml,
                                 readable, readable_files)
 
@@ -221,15 +223,16 @@ class StochasticSection:
 
 @dataclass
 class EstimationSection:
-    sigma_position: float = checked(positive, default=100e3)  # m, a priori, per axis
-    sigma_velocity: float = checked(positive, default=1.0)  # m/s, a priori, per axis
-    srp_scale_sigma: float | None = checked(positive, default=0.1)  # a priori sigma of the SRP scale (none: fixed)
+    sigma_position: float = checked(positive, default=ArcSetup.sigma_position)  # m, a priori, per axis
+    sigma_velocity: float = checked(positive, default=ArcSetup.sigma_velocity)  # m/s, a priori, per axis
+    srp_scale_sigma: float | None = checked(positive, default=ArcSetup.srp_scale_sigma)  # a priori sigma of the SRP scale (none: fixed)
     stochastic: StochasticSection | None = None  # Gauss-Markov RTN accelerations (none: off)
     # LOS sigma (m, m/s) by "observable" or "observable:station" (the station's entry wins); angle observables:
     # the angle's own sigma, a number in rad or a string with its unit ("0.01 deg", "36 arcsec", "1e-4 rad")
     data_sigma: dict[str, float | str] = checked(lambda v: _data_sigmas(v),
-                                                 default_factory=lambda: {"range": 2.0, "doppler_2way": 1e-4})
-    range_bias_sigma: float | None = checked(positive, default=5.0)  # m, a per-pass range bias (none: not estimated)
+                                                 default_factory=lambda: dict(DATA_SIGMA))
+    # m, a per-pass range bias (none: not estimated)
+    range_bias_sigma: float | None = checked(positive, default=ArcSetup.range_bias_sigma)
     # one-way Doppler's oscillator, estimated when set: sigmas of its fractional frequency offset y0 and drift
     # y1 (1/s) about the arc start, one pair for every band it drives (a priori 0: the rows' reference)
     oscillator_sigma: list[float] | None = checked(positive, default=None)
@@ -239,13 +242,13 @@ class EstimationSection:
     maneuver_epoch_sigma: float | None = checked(positive, default=None)
     # innovation editing threshold (sigmas) per iteration, the last repeated; inf edits nothing
     edit_k: list[float] = checked(lambda v: positive(v, allow_inf=True),
-                                  default_factory=lambda: [float("inf"), 10.0, 5.0])
-    max_iter: int = checked(at_least(1), default=10)  # filter-smoother iterations at most
-    reweight: bool = False  # data weights from each station's post-fit RMS (the ARTEMIS practice); see README
+                                  default_factory=lambda: list(FitOptions.edit_k))
+    max_iter: int = checked(at_least(1), default=FitOptions.max_iter)  # filter-smoother iterations at most
+    reweight: bool = FitOptions.reweight  # data weights from each station's post-fit RMS (the ARTEMIS practice); see README
     # data-weight stages multiplying every sigma, loose to tight (e.g. [30, 5, 1]): the next stage starts once
     # the epoch correction is below 1 sigma, so a far-off a priori is not fitted at full weight at once
-    sigma_scale: list[float] = checked(positive, default_factory=lambda: [1.0])
-    block: float = checked(positive, default=600.0)  # s, filter grid step
+    sigma_scale: list[float] = checked(positive, default_factory=lambda: list(FitOptions.sigma_scale))
+    block: float = checked(positive, default=FitOptions.block)  # s, filter grid step
     # unlogged maneuvers: the filter's innovations are always tested (findings in the report); with a sigma
     # (m/s per axis) each finding also becomes an estimated impulsive maneuver and the arc is fitted again
     detected_maneuver_sigma: float | None = checked(positive, default=None)
