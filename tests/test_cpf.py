@@ -119,5 +119,6 @@ def test_inspect_describes_and_convert_refuses_a_cpf(shared_data, tmp_path, caps
     assert main(["inspect", str(shared_data / FULL)]) == 0
     out = capsys.readouterr().out
     assert "format: parsers.cpf" in out and "frame: ITRF" in out and "positions: 288" in out
-    assert main(["convert", str(shared_data / FULL), "-o", str(tmp_path / "x.parquet")]) == 1
-    assert "is not tracking data" in capsys.readouterr().out
+    # bad input: one line on stderr, status 2
+    assert main(["convert", str(shared_data / FULL), "-o", str(tmp_path / "x.parquet")]) == 2
+    assert capsys.readouterr().err == f"error: {shared_data / FULL} is not tracking data\n"

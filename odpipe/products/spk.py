@@ -54,12 +54,12 @@ class SpkTrajectory:
     """A body's trajectory from an SPK file through SPICE (e.g. a reference or truth ephemeris).
 
     ``state(t_tdb) -> (N,6)`` m, m/s in ICRF axes about ``center``; ``t0``, ``t1``
-    bound the file's coverage of the body (s TDB).
+    bound the file's coverage of the body (s TDB). The file is loaded into SPICE only while
+    ``state`` reads it, so the kernel pool never holds a file that may later be moved or removed.
     """
 
     def __init__(self, path, body_id: int, center: str = "earth"):
         self.path, self.body, self.center = str(path), int(body_id), center
-        sp.furnsh(self.path)
         cover = sp.spkcov(self.path, self.body)
         windows = [sp.wnfetd(cover, i) for i in range(sp.wncard(cover))]
         if not windows:
@@ -69,4 +69,8 @@ class SpkTrajectory:
     def state(self, t_tdb) -> np.ndarray:
         t = np.atleast_1d(np.asarray(t_tdb, float))
         center = NAIF_IDS[self.center]
-        return np.array([sp.spkgeo(self.body, float(x), "J2000", center)[0] for x in t]) * 1e3
+        sp.furnsh(self.path)
+        try:
+            return np.array([sp.spkgeo(self.body, float(x), "J2000", center)[0] for x in t]) * 1e3
+        finally:
+            sp.unload(self.path)
