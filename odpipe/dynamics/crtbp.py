@@ -91,7 +91,7 @@ def crtbp_rhs(t, y, model, dy):
 @overload(derivative)
 def _derivative_crtbp(t, y, model, dy):
     if isinstance(model, types.Array):
-        return lambda t, y, model, dy: crtbp_rhs(t, y, model, dy)
+        return crtbp_rhs.py_func
     return None
 
 

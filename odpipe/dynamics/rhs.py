@@ -145,5 +145,5 @@ def rhs(t, y, model, dy):
 @overload(derivative)
 def _derivative_orbit(t, y, model, dy):
     if isinstance(model, types.BaseTuple):
-        return lambda t, y, model, dy: rhs(t, y, model, dy)
+        return rhs.py_func
     return None

@@ -26,6 +26,7 @@ import pandas as pd
 
 from odpipe.analysis import maneuvers as maneuver_report
 from odpipe.analysis import overlap
+from odpipe.dynamics.compile_timer import compile_timer
 from odpipe.pipeline.run import run_config
 from odpipe.products.atomic import write_text
 from odpipe.products.spk import SpkTrajectory
@@ -119,7 +120,19 @@ step = 600.0
 
 
 def _run_arc(path: Path) -> dict:
-    return run_config(path, progress=None)
+    with compile_timer() as ct:
+        detail = run_config(path, progress=None)
+    return {**detail, "numba_compile_s": ct.seconds, "numba_functions": ct.functions}
+
+
+def compile_note(main, outcomes) -> str:
+    """One line: numba compilation in the main process (``main``, a CompileTimer) and in the workers' arcs."""
+    w_s = sum(o.detail.get("numba_compile_s", 0.0) for o in outcomes)
+    w_n = sum(o.detail.get("numba_functions", 0) for o in outcomes)
+    if main.functions + w_n == 0:
+        return "numba: no compilation, every kernel loaded from the on-disk cache"
+    return (f"numba: compiled {main.functions} functions in {main.seconds:.1f} s in the main process and "
+            f"{w_n} in {w_s:.1f} s in the workers (once per checkout; later runs load them from the cache)")
 
 
 def run_demo(out: Path = Path("out/demo"), workers: int = 2, progress=print) -> dict:
@@ -133,25 +146,27 @@ def run_demo(out: Path = Path("out/demo"), workers: int = 2, progress=print) -> 
              "executed": case_dir / "maneuvers_executed_truth.csv"}
     files.update({f"utdf:{n.station}": case_dir / f"{stem}_{n.station}.utdf" for n in case.networks
                   if n.format == "utdf"})
-    if not all(p.exists() for p in files.values()):
-        progress(f"simulating the case {CASE.name} into {case_dir} ...")
-        run_case(CASE, case_dir)
-    truth = SpkTrajectory(files["spk"], case.naif_id)
-    sigmas = data_sigmas(case)
-    arc_dir = out / "arcs"
-    arc_dir.mkdir(parents=True, exist_ok=True)
-    plan = arcs(float(utc_to_tdb(case.start)), float(utc_to_tdb(case.end)),
-                list(np.asarray(utc_to_tdb(case.station_keeping_epochs()), float)))
-    configs = []
-    for name, _, a, b in plan:
-        path = arc_dir / f"{name}.toml"
-        text = arc_config(case, files, name, a, b, truth.state(a)[0] + OFFSET, sigmas)
-        if not path.exists() or path.read_text() != text:
-            write_text(path, text)
-        configs.append(path)
-    progress(f"fitting {len(configs)} arcs on {workers} workers ...")
-    outcomes = run_batch(configs, _run_arc, workers=workers, progress=progress)
+    with compile_timer() as main_compile:
+        if not all(p.exists() for p in files.values()):
+            progress(f"simulating the case {CASE.name} into {case_dir} ...")
+            run_case(CASE, case_dir)
+        truth = SpkTrajectory(files["spk"], case.naif_id)
+        sigmas = data_sigmas(case)
+        arc_dir = out / "arcs"
+        arc_dir.mkdir(parents=True, exist_ok=True)
+        plan = arcs(float(utc_to_tdb(case.start)), float(utc_to_tdb(case.end)),
+                    list(np.asarray(utc_to_tdb(case.station_keeping_epochs()), float)))
+        configs = []
+        for name, _, a, b in plan:
+            path = arc_dir / f"{name}.toml"
+            text = arc_config(case, files, name, a, b, truth.state(a)[0] + OFFSET, sigmas)
+            if not path.exists() or path.read_text() != text:
+                write_text(path, text)
+            configs.append(path)
+        progress(f"fitting {len(configs)} arcs on {workers} workers ...")
+        outcomes = run_batch(configs, _run_arc, workers=workers, progress=progress)
     progress(night_summary(outcomes))
+    progress(compile_note(main_compile, outcomes))
     return _report(out, case, plan, files, truth)
 
 

@@ -1,0 +1,145 @@
+"""Where a GRAIL-B daily arc spends its time: wall seconds by pipeline stage and by fit iteration.
+
+    python benchmarks/profile_grail_arc.py [runs/grail_b_2012_04_10.toml] [--interval 0.002]
+
+Runs the arc's configuration like ``odpipe run`` (``force``: always fitted again) while a
+sampling thread reads the main thread's Python stack every ``interval`` seconds. Each
+interval's wall time goes to the innermost frame that belongs to a stage:
+
+    ingest          parsers/, odpipe/pipeline/ingest.py
+    media           odpipe/media/
+    compression     odpipe/preprocess/compress.py
+    editing         the rest of odpipe/preprocess/
+    integration     odpipe/dynamics/ (DOP853 with the variational equations, the field kernel)
+    light time      odpipe/measurements/ (light-time solution, observables and their partials)
+    filter          odpipe/estimation/ and odpipe/od/ outside the two above
+    smoother        odpipe/estimation/smoother.py
+    products        odpipe/products/, odpipe/runs/, odpipe/pipeline/products.py, run.py:_products
+    set-up          the rest of odpipe/pipeline (force model, a priori trajectory, geometry)
+
+Frames of odpipe/frames, odpipe/time, odpipe/environment, numpy, scipy and pandas are
+passed over (they count for the stage that called them). numba kernels hold the GIL, so
+a sample lands just after the kernel returns, in the frame that called it: stages are
+right to the length of one kernel call. Time inside ``odpipe.estimation.fit.fit`` is
+also split by (fit call, iteration, weight stage). numba compilation (none when its
+cache is warm: run twice) is reported apart. Figures are printed, never asserted.
+"""
+
+from __future__ import annotations
+
+import argparse
+import sys
+import threading
+import time
+from collections import defaultdict
+from pathlib import Path
+
+ROOT = Path(__file__).resolve().parents[1]
+sys.path.insert(0, str(ROOT))
+
+from odpipe.dynamics.compile_timer import compile_timer  # noqa: E402
+from odpipe.pipeline.run import run_config  # noqa: E402
+from odpipe.runs.schema import ConfigError  # noqa: E402
+
+STAGES = [  # (path fragment, stage): the first fragment found in a frame's file name wins
+    ("/parsers/", "ingest"), ("/odpipe/pipeline/ingest.py", "ingest"),
+    ("/odpipe/media/", "media"),
+    ("/odpipe/preprocess/compress.py", "compression"), ("/odpipe/preprocess/", "editing"),
+    ("/odpipe/dynamics/", "integration"),
+    ("/odpipe/measurements/", "light time and partials"),
+    ("/odpipe/estimation/smoother.py", "smoother"),
+    ("/odpipe/estimation/", "filter"), ("/odpipe/od/", "filter"),
+    ("/odpipe/products/", "products"), ("/odpipe/runs/", "products"), ("/odpipe/pipeline/products.py", "products"),
+    ("/odpipe/pipeline/", "set-up"),
+]
+ORDER = ["ingest", "set-up", "media", "compression", "editing", "integration", "light time and partials",
+         "filter", "smoother", "products", "other"]
+
+
+def stage_of(frame) -> str:
+    """Stage of the innermost frame on ``frame``'s stack that belongs to one."""
+    while frame is not None:
+        name = frame.f_code.co_filename.replace("\\", "/")
+        if name.endswith("/odpipe/pipeline/run.py") and frame.f_code.co_name == "_products":
+            return "products"
+        for frag, stage in STAGES:
+            if frag in name:
+                return stage
+        frame = frame.f_back
+    return "other"
+
+
+def fit_position(frame, calls: dict) -> tuple | None:
+    """(fit call, iteration, weight stage) if ``frame`` runs inside odpipe.estimation.fit.fit."""
+    while frame is not None:
+        if frame.f_code.co_name == "fit" and frame.f_code.co_filename.endswith("/odpipe/estimation/fit.py"):
+            loc = frame.f_locals
+            call = calls.setdefault(id(frame), len(calls) + 1)
+            return call, loc.get("it"), loc.get("stage")
+        frame = frame.f_back
+    return None
+
+
+class Sampler(threading.Thread):
+    """Samples the stack of thread ``ident`` every ``interval`` s; wall seconds by stage and by fit step."""
+
+    def __init__(self, ident: int, interval: float):
+        super().__init__(daemon=True)
+        self.target, self.interval = ident, interval
+        self.by_stage = defaultdict(float)
+        self.by_fit = defaultdict(lambda: defaultdict(float))
+        self.calls: dict = {}
+        self.stop = threading.Event()
+
+    def run(self):
+        last = time.perf_counter()
+        while not self.stop.wait(self.interval):
+            frame = sys._current_frames().get(self.target)
+            now = time.perf_counter()
+            dt, last = now - last, now
+            if frame is None:
+                continue
+            stage = stage_of(frame)
+            self.by_stage[stage] += dt
+            pos = fit_position(frame, self.calls)
+            if pos is not None:
+                self.by_fit[pos][stage] += dt
+
+
+def main(argv=None) -> int:
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("config", nargs="?", type=Path, default=ROOT / "runs" / "grail_b_2012_04_10.toml")
+    ap.add_argument("--interval", type=float, default=0.002, help="sampling interval, s")
+    args = ap.parse_args(argv)
+    sampler = Sampler(threading.get_ident(), args.interval)
+    sampler.start()
+    t0 = time.perf_counter()
+    try:
+        with compile_timer() as ct:
+            summary = run_config(args.config, force=True, progress=None)
+    except ConfigError as exc:
+        print(exc)
+        return 1
+    wall = time.perf_counter() - t0
+    sampler.stop.set()
+    sampler.join()
+    print(f"{args.config.name}: {wall:.1f} s wall, of which numba compiled {ct.functions} functions in "
+          f"{ct.seconds:.1f} s; fit {summary.get('fit_seconds', float('nan')):.1f} s")
+    total = sum(sampler.by_stage.values())
+    print(f"\n{'stage':26s} {'s':>7s} {'share':>6s}")
+    for stage in ORDER:
+        s = sampler.by_stage.get(stage, 0.0)
+        if s:
+            print(f"{stage:26s} {s:7.2f} {s / total:6.1%}")
+    cols = [s for s in ("integration", "light time and partials", "filter", "smoother", "other")
+            if any(v.get(s) for v in sampler.by_fit.values())]
+    print(f"\n{'fit call':>8s} {'iter':>4s} {'w.stage':>7s} {'total':>7s} " + " ".join(f"{c[:12]:>12s}" for c in cols))
+    for (call, it, st), v in sorted(sampler.by_fit.items(), key=lambda kv: tuple(-1 if x is None else x
+                                                                                 for x in kv[0])):
+        print(f"{call:8d} {it if it is not None else '-':>4} {st if st is not None else '-':>7} "
+              f"{sum(v.values()):7.2f} " + " ".join(f"{v.get(c, 0.0):12.2f}" for c in cols))
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
