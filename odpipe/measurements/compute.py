@@ -2,8 +2,11 @@
 
 ``compute(rows, trajectories, setup) -> Evaluation``
 
-Rows are grouped by (observable, unit, stations, spacecraft, tag) and each
-group is evaluated vectorized. Supported observables and their row fields:
+Rows are grouped by (observable, unit, stations, spacecraft, tag) into a :class:`Group` and each
+group is evaluated vectorized by the model registered for its observable (:data:`MODELS`). A new
+observable is one function ``@model("name") def f(group) -> (Computed, roles)`` in this module;
+light time (``group.solve``) and media (below) are applied the same way for every model.
+Supported observables and their row fields:
 
 =================  ==========================================================================
 range              two/three-way range, ``unit`` 'RU', 'm' or 's', tagged at reception; band_up
@@ -163,91 +166,158 @@ def _spanning(setup: MeasurementSetup, epoch: pd.Series) -> MeasurementSetup:
     return spanning(setup, t[0] - SPAN_MARGIN_S, t[1] + SPAN_MARGIN_S)
 
 
-def _evaluate(key, g, trajectories, setup):
-    obs, unit, tx, rx, sc, sc2, tag = key
-    tx = tx or rx
-    traj = _trajectory(trajectories, sc)
-    epoch = g["epoch"].to_numpy(dtype="datetime64[ns]")
-    bodies = dict(shapiro_bodies=setup.shapiro_bodies, ephemeris=setup.ephemeris, origin=setup.origin)
+@dataclass
+class Group:
+    """Rows sharing one observable, unit, link (tx, rx), spacecraft (sc, sc2) and time tag, with what a model
+    needs: the trajectories by spacecraft id and the set-up."""
 
-    def solve(nodes, utc, anchor="receive"):
+    obs: str
+    unit: str
+    tx: str
+    rx: str
+    sc: str
+    sc2: str
+    tag: str
+    rows: pd.DataFrame
+    trajectories: Mapping
+    setup: MeasurementSetup
+
+    @property
+    def epoch(self) -> np.ndarray:
+        return self.rows["epoch"].to_numpy(dtype="datetime64[ns]")
+
+    def trajectory(self, sc: str):
+        return _trajectory(self.trajectories, sc)
+
+    def solve(self, nodes, utc, anchor: str = "receive"):
+        """The light-time solution of the path through ``nodes`` anchored at UTC ``utc``."""
         t, c = anchor_from_utc(utc)
-        return solve_path(nodes, t, anchor=anchor, t_corr=c, **bodies)
+        return solve_path(nodes, t, anchor=anchor, t_corr=c, shapiro_bodies=self.setup.shapiro_bodies,
+                          ephemeris=self.setup.ephemeris, origin=self.setup.origin)
 
-    def interval():
-        s, e = interval_bounds(epoch.astype(np.int64), g["count_time"].to_numpy(float), g["tag"].to_numpy(object))
+    def interval(self):
+        """Start and end (UTC) of each row's count interval."""
+        s, e = interval_bounds(self.epoch.astype(np.int64), self.rows["count_time"].to_numpy(float),
+                               self.rows["tag"].to_numpy(object))
         return s.astype("datetime64[ns]"), e.astype("datetime64[ns]")
 
-    if obs == "range" or obs.startswith("doppler_") and obs != "doppler_1way":
-        if obs == "range" and tag not in ("receive", "interval_end"):
-            raise _Unsupported(f"range tagged {tag!r}: only reception tags are modelled")
-        st_tx, st_rx = setup.station(tx), setup.station(rx)
-        nodes = [st_tx, setup.spacecraft(traj, sc), st_rx]
-        up = _uplink(g, tx, setup)
-        roles = {"station_tx": ("station", tx, st_tx), "station_rx": ("station", rx, st_rx), "spacecraft": ("sc", sc, traj)}
-        if obs == "range":
-            ru = range_unit_factor(g["band_up"].to_numpy(object))
-            modulus = _column(g, ("range_modulus", "range_modulus_ru"))
-            delay = np.nan_to_num(g["delay_s"].to_numpy(float)) if "delay_s" in g.columns else 0.0
-            delay = delay - 2.0 * setup.com_offsets.get(sc, 0.0) / C_LIGHT
-            if unit not in ("RU", "m", "s"):
-                raise _Unsupported(f"range in unit {unit!r}: only RU, m and s are modelled")
-            return dsn.dsn_range(solve(nodes, epoch), up, tx, epoch, ru, unit, delay, modulus), roles
-        m2 = g["transponder_ratio"].to_numpy(float)
-        m2 = np.where(np.isfinite(m2), m2, turnaround_ratio(g["band_up"].to_numpy(object), g["band_down"].to_numpy(object)))
-        s, e = interval()
-        ref = None
-        if "odf_data_type" in g.columns and g["ramped"].to_numpy(bool).all():
-            ref = g["reference_hz"].to_numpy(float)  # ODF ramped Doppler: M2 f_REF - f_received
-        elif obs == "doppler_3way" and setup.ramps is not None and rx in getattr(setup.ramps, "stations", []) \
-                and g["ramped"].to_numpy(bool).all():
-            ref = setup.ramps
-        return dsn.dsn_doppler(solve(nodes, s), solve(nodes, e), up, tx, s, e, m2, ref, rx), roles
-    if obs == "doppler_1way":
-        st_rx = setup.station(rx)
-        nodes = [setup.spacecraft(traj, sc), st_rx]
-        f_ref = g["uplink_hz"].to_numpy(float)
-        if "odf_data_type" in g.columns:  # ODF gives the one-way reference at S-band scale (parsers.odf)
-            f_ref = f_ref * ONE_WAY_SCALE.get(band_name(g["band_down"].iloc[0]), np.nan)
-        y0, y1, t_ref = setup.oscillators.get(sc, (0.0, 0.0, 0.0))
-        s, e = interval()
-        sols = solve(nodes, s), solve(nodes, e)
-        proper = 0.5 * sum(proper_rate_offset(setup.ephemeris, setup.origin, p.epochs[:, 0] + p.epoch_corr[:, 0],
-                                              p.states[:, 0]) for p in sols)
-        comp = dsn.one_way_doppler(*sols, f_ref, g["count_time"].to_numpy(float), y0, y1, t_ref, proper)
-        comp.params[f"oscillator:{sc}"] = np.stack([comp.params.pop("osc_y0"), comp.params.pop("osc_y1")], 1)
-        return comp, {"station_rx": ("station", rx, st_rx), "spacecraft": ("sc", sc, traj)}
-    if obs in _ANGLES:
-        st_rx = setup.station(rx)
-        sol = solve([setup.spacecraft(traj, sc), st_rx], epoch)
-        comp = angles.antenna_angle(sol, st_rx, _ANGLES[obs])
-        if obs == "angle_el" and setup.elevation_refraction:
-            comp = refraction.refracted(comp, setup.stations[rx].geodetic()[2])
-        return comp, {"station_rx": ("station", rx, st_rx), "spacecraft": ("sc", sc, traj)}
-    if obs == "range_rate":
-        st_rx = setup.station(rx)
-        t, c = anchor_from_utc(epoch)
-        comp = instantaneous.instantaneous_range_rate(st_rx.state(t), setup.spacecraft(traj, sc).state(t), t,
-                                                      ("station_rx", "spacecraft"))
-        return comp, {"station_rx": ("station", rx, st_rx), "spacecraft": ("sc", sc, traj)}
-    if obs in ("sst_range", "sst_doppler", "dowr_sum", "dowr_diff"):
-        traj2 = _trajectory(trajectories, sc2)
-        n1, n2 = setup.spacecraft(traj, sc), setup.spacecraft(traj2, sc2)
-        roles = {"sc1": ("sc", sc, traj), "sc2": ("sc", sc2, traj2)}
-        if obs == "sst_range":
-            return crosslink.two_way_range(solve([n1, n2, n1], epoch)), roles
-        if obs == "sst_doppler":
-            s, e = interval()
-            return crosslink.two_way_doppler(solve([n1, n2, n1], s), solve([n1, n2, n1], e),
-                                             g["count_time"].to_numpy(float)), roles
-        c1, c2 = setup.clocks.get(sc, crosslink.ClockModel()), setup.clocks.get(sc2, crosslink.ClockModel())
-        total, diff = crosslink.dual_one_way(solve([n2, n1], epoch), solve([n1, n2], epoch), c1, c2)
-        comp = total if obs == "dowr_sum" else diff
-        for who in ("sc1", "sc2"):
-            name = sc if who == "sc1" else sc2
-            comp.params[f"clock:{name}"] = np.stack([comp.params.pop(f"clock_{who}_{k}") for k in ("a0", "a1", "a2")], 1)
-        return comp, roles
-    raise _Unsupported(f"observable {obs!r} has no model")
+
+MODELS: dict[str, Callable[[Group], tuple]] = {}  # observable -> model(group) -> (Computed, roles): the registry
+
+
+def model(*observables: str):
+    """Register a measurement model for ``observables``: ``f(group: Group) -> (Computed, roles)``, roles naming
+    each participant's partials (``{"station_rx": ("station", id, node), "spacecraft": ("sc", id, trajectory)}``)."""
+    def register(fn):
+        for name in observables:
+            MODELS[name] = fn
+        return fn
+    return register
+
+
+def _evaluate(key, g, trajectories, setup):
+    obs, unit, tx, rx, sc, sc2, tag = key
+    if obs not in MODELS:
+        raise _Unsupported(f"observable {obs!r} has no model")
+    return MODELS[obs](Group(obs, unit, tx or rx, rx, sc, sc2, tag, g, trajectories, setup))
+
+
+def _receiver(grp: Group, st_rx, traj) -> dict:
+    """The roles of a one-station observable: the receiving station and the spacecraft."""
+    return {"station_rx": ("station", grp.rx, st_rx), "spacecraft": ("sc", grp.sc, traj)}
+
+
+@model("range", "doppler_2way", "doppler_3way")
+def _dsn_two_way(grp: Group):
+    """DSN two- and three-way range and ramped Doppler (Moyer)."""
+    g, setup, tx, rx, sc = grp.rows, grp.setup, grp.tx, grp.rx, grp.sc
+    if grp.obs == "range" and grp.tag not in ("receive", "interval_end"):
+        raise _Unsupported(f"range tagged {grp.tag!r}: only reception tags are modelled")
+    traj = grp.trajectory(sc)
+    st_tx, st_rx = setup.station(tx), setup.station(rx)
+    nodes = [st_tx, setup.spacecraft(traj, sc), st_rx]
+    up = _uplink(g, tx, setup)
+    roles = {"station_tx": ("station", tx, st_tx), "station_rx": ("station", rx, st_rx), "spacecraft": ("sc", sc, traj)}
+    if grp.obs == "range":
+        ru = range_unit_factor(g["band_up"].to_numpy(object))
+        modulus = _column(g, ("range_modulus", "range_modulus_ru"))
+        delay = np.nan_to_num(g["delay_s"].to_numpy(float)) if "delay_s" in g.columns else 0.0
+        delay = delay - 2.0 * setup.com_offsets.get(sc, 0.0) / C_LIGHT
+        if grp.unit not in ("RU", "m", "s"):
+            raise _Unsupported(f"range in unit {grp.unit!r}: only RU, m and s are modelled")
+        return dsn.dsn_range(grp.solve(nodes, grp.epoch), up, tx, grp.epoch, ru, grp.unit, delay, modulus), roles
+    m2 = g["transponder_ratio"].to_numpy(float)
+    m2 = np.where(np.isfinite(m2), m2, turnaround_ratio(g["band_up"].to_numpy(object), g["band_down"].to_numpy(object)))
+    s, e = grp.interval()
+    ref = None
+    if "odf_data_type" in g.columns and g["ramped"].to_numpy(bool).all():
+        ref = g["reference_hz"].to_numpy(float)  # ODF ramped Doppler: M2 f_REF - f_received
+    elif grp.obs == "doppler_3way" and setup.ramps is not None and rx in getattr(setup.ramps, "stations", []) \
+            and g["ramped"].to_numpy(bool).all():
+        ref = setup.ramps
+    return dsn.dsn_doppler(grp.solve(nodes, s), grp.solve(nodes, e), up, tx, s, e, m2, ref, rx), roles
+
+
+@model("doppler_1way")
+def _one_way_doppler(grp: Group):
+    """One-way Doppler from the spacecraft's oscillator, transmitting in its proper time."""
+    g, setup, sc = grp.rows, grp.setup, grp.sc
+    traj, st_rx = grp.trajectory(sc), setup.station(grp.rx)
+    nodes = [setup.spacecraft(traj, sc), st_rx]
+    f_ref = g["uplink_hz"].to_numpy(float)
+    if "odf_data_type" in g.columns:  # ODF gives the one-way reference at S-band scale (parsers.odf)
+        f_ref = f_ref * ONE_WAY_SCALE.get(band_name(g["band_down"].iloc[0]), np.nan)
+    y0, y1, t_ref = setup.oscillators.get(sc, (0.0, 0.0, 0.0))
+    s, e = grp.interval()
+    sols = grp.solve(nodes, s), grp.solve(nodes, e)
+    proper = 0.5 * sum(proper_rate_offset(setup.ephemeris, setup.origin, p.epochs[:, 0] + p.epoch_corr[:, 0],
+                                          p.states[:, 0]) for p in sols)
+    comp = dsn.one_way_doppler(*sols, f_ref, g["count_time"].to_numpy(float), y0, y1, t_ref, proper)
+    comp.params[f"oscillator:{sc}"] = np.stack([comp.params.pop("osc_y0"), comp.params.pop("osc_y1")], 1)
+    return comp, _receiver(grp, st_rx, traj)
+
+
+@model(*_ANGLES)
+def _antenna_angle(grp: Group):
+    """Antenna angles at the receiving station (elevation refracted when the set-up asks)."""
+    setup, traj = grp.setup, grp.trajectory(grp.sc)
+    st_rx = setup.station(grp.rx)
+    comp = angles.antenna_angle(grp.solve([setup.spacecraft(traj, grp.sc), st_rx], grp.epoch), st_rx, _ANGLES[grp.obs])
+    if grp.obs == "angle_el" and setup.elevation_refraction:
+        comp = refraction.refracted(comp, setup.stations[grp.rx].geodetic()[2])
+    return comp, _receiver(grp, st_rx, traj)
+
+
+@model("range_rate")
+def _instantaneous_range_rate(grp: Group):
+    """Instantaneous station-to-spacecraft range rate (no light time)."""
+    setup, traj, st_rx = grp.setup, grp.trajectory(grp.sc), grp.setup.station(grp.rx)
+    t, _ = anchor_from_utc(grp.epoch)
+    comp = instantaneous.instantaneous_range_rate(st_rx.state(t), setup.spacecraft(traj, grp.sc).state(t), t,
+                                                  ("station_rx", "spacecraft"))
+    return comp, _receiver(grp, st_rx, traj)
+
+
+@model("sst_range", "sst_doppler", "dowr_sum", "dowr_diff")
+def _crosslink(grp: Group):
+    """Spacecraft-to-spacecraft two-way range and Doppler, and dual one-way ranging with clocks."""
+    setup, sc, sc2 = grp.setup, grp.sc, grp.sc2
+    traj, traj2 = grp.trajectory(sc), grp.trajectory(sc2)
+    n1, n2 = setup.spacecraft(traj, sc), setup.spacecraft(traj2, sc2)
+    roles = {"sc1": ("sc", sc, traj), "sc2": ("sc", sc2, traj2)}
+    if grp.obs == "sst_range":
+        return crosslink.two_way_range(grp.solve([n1, n2, n1], grp.epoch)), roles
+    if grp.obs == "sst_doppler":
+        s, e = grp.interval()
+        return crosslink.two_way_doppler(grp.solve([n1, n2, n1], s), grp.solve([n1, n2, n1], e),
+                                         grp.rows["count_time"].to_numpy(float)), roles
+    c1, c2 = setup.clocks.get(sc, crosslink.ClockModel()), setup.clocks.get(sc2, crosslink.ClockModel())
+    total, diff = crosslink.dual_one_way(grp.solve([n2, n1], grp.epoch), grp.solve([n1, n2], grp.epoch), c1, c2)
+    comp = total if grp.obs == "dowr_sum" else diff
+    for who in ("sc1", "sc2"):
+        name = sc if who == "sc1" else sc2
+        comp.params[f"clock:{name}"] = np.stack([comp.params.pop(f"clock_{who}_{k}") for k in ("a0", "a1", "a2")], 1)
+    return comp, roles
 
 
 def _column(g, names):
