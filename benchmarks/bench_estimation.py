@@ -12,13 +12,17 @@ Small matrices: on a busy machine OpenBLAS threading can cost 10x; compare with
 OPENBLAS_NUM_THREADS=1.
 """
 
+import sys
 import time
+from pathlib import Path
 
 import numpy as np
 
 from odpipe.estimation.fit import FitOptions, Observations, fit
 from odpipe.estimation.registry import ParameterRegistry
-from odpipe.estimation.testing import LinearProblem, twobody_case
+
+sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "tests"))
+from estimation_cases import LinearProblem, twobody_case  # noqa: E402  (the test problems live with the tests)
 
 DAY = 86400.0
 

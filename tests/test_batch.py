@@ -5,7 +5,7 @@ import numpy as np
 
 from odpipe.estimation.batch import batch_least_squares
 from odpipe.estimation.fit import FitOptions, fit
-from odpipe.estimation.testing import twobody_case
+from estimation_cases import twobody_case
 
 
 def test_batch_matches_weighted_polyfit_with_vague_apriori():
@@ -46,7 +46,7 @@ def test_smoother_equals_batch_linear_to_roundoff():
     """Exactly linear system: filter-smoother and batch agree to ~1e-10 of sigma."""
     from odpipe.estimation.fit import Observations
     from odpipe.estimation.registry import ParameterRegistry
-    from odpipe.estimation.testing import LinearProblem
+    from estimation_cases import LinearProblem
 
     rng = np.random.default_rng(4)
     reg = ParameterRegistry()

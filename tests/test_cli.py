@@ -154,7 +154,7 @@ def test_fit_iterations_are_logged_as_they_run(caplog):
     """Long fits show progress: each iteration's RMS and edits, logged by the fit as it goes."""
     import numpy as np
     from odpipe.estimation.fit import FitOptions, fit
-    from odpipe.estimation.testing import twobody_case
+    from estimation_cases import twobody_case
 
     prob, obs, _ = twobody_case(np.random.default_rng(3))
     with caplog.at_level(logging.INFO, logger="odpipe.estimation.fit"):

@@ -20,7 +20,7 @@ import pytest
 from scipy.stats import chi2
 
 from odpipe.estimation.fit import FitOptions, fit
-from odpipe.estimation.testing import twobody_case
+from estimation_cases import twobody_case
 
 N_RUNS = 50
 DAY = 86400.0

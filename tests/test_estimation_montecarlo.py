@@ -14,7 +14,7 @@ from scipy.stats import chi2
 
 from odpipe.estimation.fit import FitOptions, Observations, fit
 from odpipe.estimation.registry import ParameterRegistry
-from odpipe.estimation.testing import LinearProblem
+from estimation_cases import LinearProblem
 
 TAU, SIG_A, BATCH = 7200.0, 2e-7, 1800.0
 ARC, DT_OBS = 2 * 86400.0, 300.0

@@ -28,7 +28,7 @@ def test_solution_save_load_round_trip(tmp_path):
 
 
 def test_string_groups_survive_the_file(tmp_path):
-    from odpipe.estimation.testing import twobody_case
+    from estimation_cases import twobody_case
 
     prob, obs, _ = twobody_case(np.random.default_rng(2), days=0.25, maneuvers=(), stochastic=False)
     sol = fit(prob, obs, 0.0, 0.25 * 86400.0, FitOptions(block=1800.0, max_iter=2))

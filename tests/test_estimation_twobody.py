@@ -14,7 +14,7 @@ from scipy.stats import chi2
 
 from odpipe.estimation.fit import EDIT_INNOVATION, FitOptions, Observations, fit
 from odpipe.estimation.maneuvers import detect_maneuvers, maneuver_table
-from odpipe.estimation.testing import twobody_case
+from estimation_cases import twobody_case
 
 DAY = 86400.0
 

@@ -1,6 +1,6 @@
 """Non-finite rows are edited with their reason, not fatal; a fit with nothing left to fit says so.
 
-Simulated two-body arc (odpipe.estimation.testing): the fit with NaN/inf values, bad sigmas and
+Simulated two-body arc (tests/estimation_cases.py): the fit with NaN/inf values, bad sigmas and
 non-finite computed values injected must equal the fit of the same data without those rows.
 """
 
@@ -9,7 +9,7 @@ import pytest
 
 from odpipe.estimation.fit import (EDIT_INNOVATION, NONFINITE, FitDiverged, FitOptions, NothingToFit,
                                    Observations, fit)
-from odpipe.estimation.testing import TwoBodyProblem, twobody_case
+from estimation_cases import TwoBodyProblem, twobody_case
 from odpipe.preprocess.flags import Flag, names
 
 DAY = 86400.0

@@ -4,7 +4,7 @@ import numpy as np
 import pytest
 
 from odpipe.estimation.fit import FitDiverged, FitOptions, fit
-from odpipe.estimation.testing import twobody_case
+from estimation_cases import twobody_case
 
 DAY = 86400.0
 

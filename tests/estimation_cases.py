@@ -17,7 +17,7 @@ from __future__ import annotations
 import numpy as np
 from numba import njit
 
-from .registry import ParameterRegistry
+from odpipe.estimation.registry import ParameterRegistry
 
 # ---------------------------------------------------------------- linear
 
@@ -275,7 +275,7 @@ def twobody_case(rng, days=1.0, dt_obs=120.0, batch=8 * 3600.0, sig_acc=5e-9, ta
     ARTEMIS Table 4.1: 100 km, 1 m/s, 5e-9 m/s^2 accelerations, 10 mm/s and 10 s
     maneuvers, 5 m range biases; ``sigma_state`` (m, m/s) replaces the state's.
     """
-    from .fit import Observations
+    from odpipe.estimation.fit import Observations
 
     r, inc = 2.0e7, np.radians(28.5)
     v = np.sqrt(MU_EARTH / r)
