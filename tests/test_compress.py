@@ -7,6 +7,7 @@ import pytest
 from odpipe.preprocess.compress import compress
 from odpipe.preprocess.flags import Flag
 from parsers.table import build, empty_ramps
+from parsers import odf
 
 T0 = np.datetime64("2012-04-09T00:00:00", "ns")
 A, B, C, W = 2.1e6, -3.5, 40.0, 2 * np.pi / 7000.0  # Hz, Hz/s, Hz, rad/s
@@ -227,7 +228,6 @@ def smooth_fit_residuals(tab, knot_s=120.0, degree=5):
 
 @pytest.mark.realdata
 def test_grail_odf_compression(shared_data):
-    odf = pytest.importorskip("parsers.odf")
     from odpipe.preprocess.edit import edit
 
     data = odf.read(shared_data / "grail" / "grblugf2012_101_0350smmmv1.odf")

@@ -10,6 +10,7 @@ from odpipe.preprocess.flags import Flag, names, summary
 from odpipe.preprocess.robust import outliers
 from parsers import table
 from parsers.table import build
+from parsers import odf, utdf
 
 T0 = np.datetime64("2012-04-09T00:00:00", "ns")
 
@@ -169,7 +170,6 @@ GRAIL_OUTLIERS = {
 @pytest.mark.realdata
 @pytest.mark.parametrize("name", sorted(GRAIL_OUTLIERS))
 def test_grail_gross_outliers_are_flagged(shared_data, name):
-    odf = pytest.importorskip("parsers.odf")
     data = odf.read(shared_data / "grail" / name)
     tab = data.table
     big = tab.loc[tab["value"].abs() > 1e6, "record"].tolist()
@@ -187,7 +187,6 @@ def test_grail_gross_outliers_are_flagged(shared_data, name):
 
 @pytest.mark.realdata
 def test_cassini_and_messenger_ramps_and_range_are_not_edited_as_blunders(shared_data):
-    odf = pytest.importorskip("parsers.odf")
     cas = odf.read(shared_data / "cassini" / "S18TIGM2006_058_0005X25MV1.ODF")
     out, _ = edit(cas.table, cas.ramps)
     blunder = bits(out, Flag.BLUNDER)
@@ -203,7 +202,6 @@ def test_cassini_and_messenger_ramps_and_range_are_not_edited_as_blunders(shared
 
 @pytest.mark.realdata
 def test_utdf_validity_bits_decide(shared_data):
-    utdf = pytest.importorskip("parsers.utdf")
     from odpipe.preprocess.edit import invalid
 
     path = shared_data / "utdf" / "LSUTDF_367501_119_2019_044_1555.trk"

@@ -30,8 +30,7 @@ def test_detect_formats_of_real_files(shared_data, tmp_path):
               "utdf/LSUTDF_367501_119_2019_044_1555.trk": "parsers.utdf",
               "grail/mas00_2012_04_06_a_04.asc": "parsers.maneuvers"}
     for rel, name in expect.items():
-        if name in formats.available():
-            assert formats.detect(shared_data / rel) == name, rel
+        assert formats.detect(shared_data / rel) == name, rel
 
 
 def test_inspect_unknown_and_unreadable_inputs(tmp_path, capsys):
@@ -46,7 +45,6 @@ def test_inspect_unknown_and_unreadable_inputs(tmp_path, capsys):
 
 @pytest.mark.realdata
 def test_inspect_messenger_matches_the_independent_listing(shared_data, capsys):
-    pytest.importorskip("parsers.odf")
     rows = [ln.split() for ln in (shared_data / "messenger" / "odf07155.txt").read_text().splitlines()]
     data = [r for r in rows if len(r) == 19 and r[0].replace(".", "").isdigit()]
     want = Counter(TYPES[r[7]] for r in data)
@@ -64,7 +62,6 @@ def test_inspect_messenger_matches_the_independent_listing(shared_data, capsys):
 
 @pytest.mark.realdata
 def test_inspect_grail_and_cassini_agree_with_the_data_notes(shared_data, capsys):
-    pytest.importorskip("parsers.odf")
     grail = sorted((shared_data / "grail").glob("*.odf"))
     lines = inspect_lines(capsys, *grail)
     blocks = "\n".join(lines).split("== ")[1:]
@@ -88,7 +85,6 @@ def test_inspect_grail_and_cassini_agree_with_the_data_notes(shared_data, capsys
 
 @pytest.mark.realdata
 def test_convert_edit_compress_commands(shared_data, tmp_path, capsys):
-    pytest.importorskip("parsers.odf")
     from odpipe.preprocess import store
     from odpipe.preprocess.flags import Flag
 
@@ -115,8 +111,6 @@ def test_convert_edit_compress_commands(shared_data, tmp_path, capsys):
 
 @pytest.mark.realdata
 def test_convert_tdm_between_syntaxes(shared_data, tmp_path):
-    if "parsers.tdm" not in formats.available():
-        pytest.skip("parsers.tdm not present")
     src = shared_data / "tdm" / "kvn" / "TDMExample2.txt"
     assert main(["convert", str(src), "-o", str(tmp_path / "e2.xml")]) == 0
     a, b = formats.read_any(src).table, formats.read_any(tmp_path / "e2.xml").table
