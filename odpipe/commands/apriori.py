@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+from dataclasses import replace
 from pathlib import Path
 
 import numpy as np
@@ -12,10 +13,11 @@ HELP = "find a lunar orbiter's a priori orbit from the run's two-way Doppler; pr
 
 def add_arguments(parser) -> None:
     parser.add_argument("config", type=Path, help="run configuration (TOML): its data, arc, centre and field are used")
-    parser.add_argument("--station", help="receiving station of the Doppler used, e.g. DSS-24 (default: the one "
-                                          "with the most 60-s points in the arc's first 8 h)")
-    parser.add_argument("--span", type=float, default=5.5, help="hours of that station's Doppler used (default 5.5)")
-    parser.add_argument("--degree", type=int, default=12, help="degree of the central body's field (default 12)")
+    parser.add_argument("--station", help="receiving station of the Doppler used, e.g. DSS-24 (default: the config's "
+                                          "[initial_state.from_doppler], else the one with the most 60-s points in "
+                                          "the arc's first 8 h)")
+    parser.add_argument("--span", type=float, help="hours of that station's Doppler used (default: the config's, else 5.5)")
+    parser.add_argument("--degree", type=int, help="degree of the central body's field (default: the config's, else 12)")
 
 
 def run(args) -> int:
@@ -23,7 +25,10 @@ def run(args) -> int:
     from odpipe.pipeline.config import DopplerAprioriSection, load_config
 
     cfg = load_config(args.config)
-    res, rows = doppler_apriori(cfg, DopplerAprioriSection(args.station, args.span, args.degree))
+    how = cfg.initial_state.from_doppler or DopplerAprioriSection()
+    how = replace(how, **{k: v for k, v in (("station", args.station), ("span_hours", args.span),
+                                             ("degree", args.degree)) if v is not None})
+    res, rows = doppler_apriori(cfg, how)
     el = res.elements
     print(f"# {len(rows)} 60-s two-way Doppler points of {rows['station_rx'].iloc[0]}, "
           f"{rows['epoch'].min():%Y-%m-%dT%H:%M:%S} .. {rows['epoch'].max():%Y-%m-%dT%H:%M:%S} UTC; "
