@@ -4,7 +4,7 @@ import numpy as np
 import pandas as pd
 import pytest
 
-from odpipe.preprocess import ambiguity, weights
+from odpipe.preprocess import ambiguity
 from odpipe.preprocess.edit import EditConfig, blunders, edit
 from odpipe.preprocess.flags import Flag, names, summary
 from odpipe.preprocess.robust import outliers
@@ -137,21 +137,6 @@ def test_residual_outliers_flag_only_used_rows():
     tab.loc[30, "flags"] = int(Flag.RESIDUAL)
     resid[30] = 0.0                      # flagged by an earlier iteration, now fits: re-tested
     assert np.flatnonzero(residual_outliers(tab, resid, k=6.0)).tolist() == [10, 700]
-
-
-def test_station_weights_from_postfit_rms():
-    rng = np.random.default_rng(6)
-    a, b = sine_doppler(n=4000, station_rx="DSS-24"), sine_doppler(n=4000, station_rx="DSS-54")
-    tab = pd.concat([a, b], ignore_index=True)
-    resid = np.concatenate([rng.normal(0, 0.002, 4000), rng.normal(0, 0.008, 4000)])
-    tab.loc[[0, 1], "flags"] = int(Flag.BLUNDER)
-    resid[:2] = 1e3  # flagged rows do not count
-    w = weights.station_weights(tab, resid)
-    rms = w.set_index("station_rx")["rms"]
-    assert rms["DSS-24"] == pytest.approx(0.002, rel=0.05) and rms["DSS-54"] == pytest.approx(0.008, rel=0.05)
-    assert w.set_index("station_rx")["rows"]["DSS-24"] == 3998
-    out = weights.apply_weights(tab, w)
-    assert np.allclose(out.loc[out["station_rx"] == "DSS-54", "sigma"], rms["DSS-54"])
 
 
 def test_summary_counts_each_reason():
