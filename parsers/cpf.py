@@ -28,12 +28,11 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 
+from odpipe.constants import MJD_ORIGIN, NS_PER_DAY
 from parsers.errors import ParseError, ParseReport, check_mode, handle
 from parsers.fields import Fields, numbered_lines, date_ns
 
 FRAMES = {0: "ITRF", 1: "TOD", 2: "EME2000"}
-MJD0 = np.datetime64("1858-11-17", "ns")
-DAY_NS = 86400 * 10**9
 
 
 @dataclass
@@ -138,9 +137,9 @@ def _position(f: Fields) -> list:
     f.need(8, "direction, MJD, seconds of day, leap second, x, y, z")
     mjd = f.int(2, "MJD")
     sod_ns = f.seconds_ns(3, "seconds of day")
-    if sod_ns > DAY_NS:
+    if sod_ns > NS_PER_DAY:
         raise f.error(f"seconds of day {f.str(3)} beyond 86400")
-    epoch = MJD0 + np.timedelta64(mjd * DAY_NS + sod_ns, "ns")
+    epoch = MJD_ORIGIN + np.timedelta64(mjd * NS_PER_DAY + sod_ns, "ns")
     return [epoch, mjd, sod_ns / 1e9, f.int(4, "leap second"), f.int(1, "direction"),
             *(f.float(5 + k, f"{c} (m)") for k, c in enumerate("xyz")), np.nan, np.nan, np.nan, f.number]
 

@@ -66,12 +66,12 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 
+from odpipe.constants import C_LIGHT, NS_PER_DAY
 from parsers import table as tt
 from parsers.errors import ParseError, ParseReport, check_mode, handle
 from parsers.fields import Fields, numbered_lines, date_ns
 from parsers.table import TrackingData
 
-C_LIGHT = 299_792_458.0  # m/s
 ROLLOVER_NS = 12 * 3600 * 10**9
 TWO_WAY_EVENTS = (0, 1, 2)
 ONE_WAY_TAG = {3: "receive", 4: "transmit", 5: "transmit", 6: "receive"}
@@ -219,7 +219,7 @@ class _Reader:
         day = s["start"].astype("datetime64[D]").astype("datetime64[ns]")
         epoch = day + np.timedelta64(rec.pop("sod"), "ns")
         if (s["start"] - epoch).astype(np.int64) > ROLLOVER_NS:
-            epoch += np.timedelta64(86400 * 10**9, "ns")
+            epoch += np.timedelta64(NS_PER_DAY, "ns")
         return {"session": s["session"], "line": f.number, "epoch": epoch, "kind": kind, **rec}
 
 

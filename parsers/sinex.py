@@ -34,6 +34,7 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 
+from odpipe.constants import NS_PER_DAY, NS_PER_S, SECONDS_PER_DAY
 from parsers.errors import ParseError, ParseReport, check_mode, handle
 from parsers.fields import Fields, numbered_lines
 
@@ -190,10 +191,10 @@ def epoch(text: str, f: Fields, what: str) -> np.datetime64:
     if yy == doy == sec == 0:
         return np.datetime64("NaT", "ns")
     year = yy if len(parts[0]) == 4 else (2000 + yy if yy <= 50 else 1900 + yy)
-    if not (doy <= 366 and sec <= 86400):
+    if not (doy <= 366 and sec <= SECONDS_PER_DAY):
         raise f.error(f"{what}: day {doy} or second {sec} out of range in {text!r}")
     jan1 = np.datetime64(f"{year:04d}-01-01", "ns")
-    return jan1 + np.timedelta64((doy - 1) * 86400 + sec, "s").astype("timedelta64[ns]")
+    return jan1 + np.timedelta64((doy - 1) * NS_PER_DAY + sec * NS_PER_S, "ns")
 
 
 def _angle(text: str, f: Fields, what: str) -> float:

@@ -45,6 +45,7 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 
+from odpipe.constants import SECONDS_PER_DAY
 from parsers import table as tt
 from parsers.atomic import write_bytes
 from parsers.errors import ParseError, ParseReport, check_mode, handle
@@ -109,7 +110,7 @@ def read(path, errors: str = "raise") -> TrackingData:
 def _check(path, raw, errors, report) -> np.ndarray:
     """Mask of sound records; the others are reported (sync bytes, time fields out of range)."""
     sync = (raw["front"] == FRONT) & (raw["rear"] == REAR)
-    times = (raw["microseconds"] < 1_000_000) & (raw["seconds_of_year"] < 366 * 86400)
+    times = (raw["microseconds"] < 1_000_000) & (raw["seconds_of_year"] < 366 * SECONDS_PER_DAY)
     ok = sync & times
     for i in np.flatnonzero(~ok):
         why = "sync bytes 0D0A01 ... 040F0F missing" if not sync[i] else "time field out of range"

@@ -9,7 +9,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from odpipe.measurements.bands import C_LIGHT
+from odpipe.constants import C_LIGHT
 from odpipe.measurements.crosslink import ClockModel, dual_one_way, two_way_doppler, two_way_range
 from odpipe.measurements.instantaneous import instantaneous_range, instantaneous_range_rate
 from odpipe.measurements.lighttime import solve_path

@@ -6,7 +6,8 @@ import numpy as np
 import pandas as pd
 import pytest
 
-from odpipe.measurements.bands import C_LIGHT, TURNAROUND
+from odpipe.constants import C_LIGHT
+from odpipe.measurements.bands import TURNAROUND
 from odpipe.measurements.computed import ConstantUplink
 from odpipe.measurements.dsn import dsn_doppler, dsn_range, one_way_doppler
 from odpipe.measurements.lighttime import anchor_from_utc, solve_path

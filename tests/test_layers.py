@@ -1,7 +1,8 @@
 """Imports follow the pipeline: a module of odpipe imports only its own layer and the layers below.
 
 ``LAYERS`` is the one statement of the order, bottom first. ``parsers`` sits beside the
-bottom: every layer may import it and it imports no odpipe. Every ``import`` counts, also
+bottom: every layer may import it and it imports no odpipe but ``BENEATH``, the constants under
+everything (odpipe.constants), which import nothing of the project. Every ``import`` counts, also
 those inside functions and under ``TYPE_CHECKING``; imports by name through ``importlib``
 (the CLI finding its commands, ``commands.liaison`` its scenario) are not seen. Each
 package of odpipe must be placed, so a new package cannot slip in without a layer.
@@ -36,6 +37,9 @@ LAYERS = (
     ("pipeline, simulator and studies", ("odpipe.pipeline", "odpipe.simulate", "odpipe.liaison")),
     ("commands", ("odpipe.commands", "odpipe.cli", "odpipe.api")),
 )
+
+# below parsers and every layer: what all of them may import (layer index -2)
+BENEATH = ("odpipe.constants",)
 
 # (importing module, imported module): imports that run up the layers on purpose, each with its reason.
 ALLOWED: dict[tuple[str, str], str] = {}
@@ -72,7 +76,9 @@ def imports(source: str, module: str, is_package: bool, known=MODULES):
 
 
 def layer_of(module: str) -> int | None:
-    """Index in LAYERS (-1 for parsers); None for a module of neither odpipe nor parsers."""
+    """Index in LAYERS (-1 for parsers, -2 for BENEATH); None for a module of neither odpipe nor parsers."""
+    if module in BENEATH:
+        return -2
     top = module.split(".")[0]
     if top == "parsers":
         return -1
@@ -98,10 +104,13 @@ def violations(module: str, path: str, source: str, is_package: bool, known=MODU
         theirs = layer_of(target)
         if theirs is None or (module, target) in ALLOWED:
             continue
-        if (own == -1 and theirs >= 0) or theirs > own:
-            where = "parsers" if own == -1 else LAYERS[own][0]
-            out.append(f"{path}:{line}: {module} ({where}) imports {target} ({LAYERS[theirs][0]})")
+        if theirs > own:
+            out.append(f"{path}:{line}: {module} ({layer_name(own)}) imports {target} ({layer_name(theirs)})")
     return out
+
+
+def layer_name(index: int) -> str:
+    return {-2: "constants", -1: "parsers"}.get(index) or LAYERS[index][0]
 
 
 def test_every_import_runs_down_the_layers():
@@ -147,5 +156,10 @@ def test_checker_finds_upward_imports():
     ]
     found = violations("parsers.fake", "parsers/fake.py", "from odpipe.time import scales\n", False, known)
     assert found == ["parsers/fake.py:1: parsers.fake (parsers) imports odpipe.time.scales (time)"]
+    assert violations("parsers.fake", "parsers/fake.py", "from odpipe.constants import C_LIGHT\n", False, known) == []
+    found = violations("odpipe.constants", "odpipe/constants.py", "import numpy\nfrom parsers import table\n"
+                       "from odpipe import log\n", False, known)
+    assert found == ["odpipe/constants.py:2: odpipe.constants (constants) imports parsers.table (parsers)",
+                     "odpipe/constants.py:3: odpipe.constants (constants) imports odpipe.log (foundation)"]
     with pytest.raises(LookupError, match="odpipe.nowhere is in no layer"):
         layer_of("odpipe.nowhere")

@@ -13,7 +13,7 @@ from odpipe.dynamics.propagator import propagate
 from odpipe.estimation.registry import ParameterRegistry
 from odpipe.liaison import dowr
 from odpipe.measurements import MeasurementSetup
-from odpipe.measurements.bands import C_LIGHT
+from odpipe.constants import C_LIGHT
 from odpipe.measurements.crosslink import ClockModel, one_way_pseudorange
 from odpipe.measurements.lighttime import solve_path
 from odpipe.measurements.nodes import SpacecraftNode

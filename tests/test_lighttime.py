@@ -5,7 +5,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from odpipe.measurements.bands import C_LIGHT
+from odpipe.constants import C_LIGHT
 from odpipe.measurements.lighttime import solve_path
 from odpipe.measurements.nodes import SpacecraftNode, StationNode, geocentric_tdb_minus_tt
 from test_measurements_helpers import DE440, DSS14_ITRS, GM, CircularTrajectory, Perturbed, rigid_earth

@@ -70,7 +70,7 @@ def rigid_earth(theta0=0.3, t_ref=7.9e8):
     near the test epochs (an angle of omega*t at t ~ 8e8 s is 6e4 rad and loses
     1e-11 rad, 0.1 mm at the station: visible in 1 s Doppler).
     """
-    from odpipe.measurements.nodes import EARTH_ROTATION_RATE
+    from odpipe.constants import ERA_RATE as EARTH_ROTATION_RATE
 
     def gcrs_to_itrs(t):
         th = theta0 + EARTH_ROTATION_RATE * (np.atleast_1d(t) - t_ref)

@@ -15,7 +15,7 @@ import pandas as pd
 import pytest
 
 from odpipe.measurements import MeasurementSetup, compute
-from odpipe.measurements.bands import C_LIGHT
+from odpipe.constants import C_LIGHT
 from parsers.table import build
 
 

@@ -5,7 +5,8 @@ from __future__ import annotations
 import numpy as np
 import pandas as pd
 
-from odpipe.measurements.bands import C_LIGHT, RANGE_UNIT_FACTOR, TURNAROUND, range_unit_factor, turnaround_ratio
+from odpipe.constants import C_LIGHT
+from odpipe.measurements.bands import RANGE_UNIT_FACTOR, TURNAROUND, range_unit_factor, turnaround_ratio
 from odpipe.measurements.computed import ConstantUplink
 from odpipe.measurements.dsn import dsn_range
 from odpipe.measurements.lighttime import anchor_from_utc, solve_path

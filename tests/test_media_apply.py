@@ -4,7 +4,7 @@ import numpy as np
 import pytest
 
 from odpipe.environment.stations import StationCatalog, itrs_to_geodetic, topocentric
-from odpipe.measurements.bands import C_LIGHT
+from odpipe.constants import C_LIGHT
 from odpipe.media.apply import calibrate
 from odpipe.media.model import MediaModel
 from odpipe.media.smoothing import smooth_by_group

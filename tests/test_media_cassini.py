@@ -10,7 +10,7 @@ import pytest
 from odpipe.environment.ephemeris import Ephemeris
 from odpipe.environment.stations import StationCatalog, topocentric
 from odpipe.frames.earth import gcrs_to_itrs
-from odpipe.measurements.bands import C_LIGHT
+from odpipe.constants import C_LIGHT
 from odpipe.media.apply import calibrate
 from odpipe.media.model import MediaModel
 from odpipe.time.scales import utc_to_tdb

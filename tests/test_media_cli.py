@@ -12,7 +12,7 @@ import spiceypy as sp
 from odpipe.cli import main
 from odpipe.environment.stations import StationCatalog, topocentric
 from odpipe.frames.earth import itrs_to_gcrs
-from odpipe.measurements.bands import C_LIGHT
+from odpipe.constants import C_LIGHT
 from odpipe.pipeline.geometry import add_geometry, load_trajectory
 from odpipe.preprocess import store
 from odpipe.products.segments import EphemerisSegment

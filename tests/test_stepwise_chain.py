@@ -19,7 +19,7 @@ from odpipe.cli import main
 from odpipe.environment.ephemeris import Ephemeris
 from odpipe.environment.stations import StationCatalog, topocentric
 from odpipe.frames.earth import gcrs_to_itrs
-from odpipe.measurements.bands import C_LIGHT
+from odpipe.constants import C_LIGHT
 from odpipe.media.apply import calibrate
 from odpipe.media.model import MediaModel
 from odpipe.pipeline.config import PreprocessSection

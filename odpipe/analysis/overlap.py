@@ -15,11 +15,11 @@ import numpy as np
 import pandas as pd
 from scipy.interpolate import CubicHermiteSpline
 
+from odpipe.constants import J2000, SECONDS_PER_DAY
 from odpipe.frames.local import rtn_matrix
 from odpipe.time import utc_to_tdb
 from parsers import oem
 
-_J2000 = np.datetime64("2000-01-01T12:00:00", "ns")
 
 COMPONENTS = ("radial", "intrack", "crosstrack")
 EDGE = 2e-6  # s: products start and end on whole microseconds inside their arc (pipeline.products.product_epochs)
@@ -77,7 +77,7 @@ def oem_trajectory(path) -> PiecewiseTrajectory:
     for seg in oem.read(path):
         scale = seg.meta.get("TIME_SYSTEM", "UTC")
         if scale == "TDB":
-            t = (seg.epochs - _J2000) / np.timedelta64(1, "s")
+            t = (seg.epochs - J2000) / np.timedelta64(1, "s")
         elif scale == "UTC":
             t = utc_to_tdb(seg.epochs)
         else:
@@ -187,7 +187,7 @@ def short_arc_schedule(maneuvers_tdb, arc_days: float = 5.0, margin_s: float = 3
     maneuver k+1 and lasts ``arc_days``. Returns a list of ((a0, a1), (b0, b1)).
     """
     m = np.sort(np.asarray(maneuvers_tdb, dtype=float))
-    span = arc_days * 86400.0
+    span = arc_days * SECONDS_PER_DAY
     return [((m0 + margin_s, m0 + margin_s + span), (m1 - margin_s - span, m1 - margin_s))
             for m0, m1 in zip(m[:-1], m[1:])]
 

@@ -17,6 +17,7 @@ import numpy as np
 from numba import njit, types
 from numba.extending import overload
 
+from odpipe.constants import EGM96_GM
 from odpipe.dynamics.dop853 import derivative, integrate
 from odpipe.dynamics.trajectory import Trajectory
 
@@ -26,7 +27,7 @@ class EarthMoonUnits:
     """Dimensional scales: ``length`` m, ``gm1``/``gm2`` m^3/s^2 (Earth, Moon)."""
 
     length: float = 384400.0e3
-    gm1: float = 3.986004415e14
+    gm1: float = EGM96_GM
     gm2: float = 4.902800118e12
 
     @property

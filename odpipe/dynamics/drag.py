@@ -26,9 +26,8 @@ from __future__ import annotations
 import numpy as np
 from numba import njit
 
-OMEGA_EARTH = 7.292115e-5  # rad/s (IERS 2010)
-R_EQUATOR = 6378137.0       # m, WGS-84
-FLATTENING = 1.0 / 298.257223563
+from odpipe.constants import EARTH_ROTATION_RATE as OMEGA_EARTH, WGS84_A as R_EQUATOR, WGS84_F as FLATTENING
+
 BULGE_LAG = np.radians(30.0)
 
 # height (km), minimum and maximum density (kg/m^3): M&G Table 3.8 (g/km^3 * 1e-12)

@@ -29,12 +29,13 @@ from typing import Callable, Sequence
 
 import numpy as np
 
+from odpipe.constants import EGM96_RADIUS, MOON_RADIUS
 from odpipe.numerics.chebyshev import fit_channel, stack_channels
 from odpipe.dynamics.harmonics import by_order, recursion_factors
 from odpipe.dynamics.srp import CYLINDER, P_SUN_1AU, PLATE, SUN_CYLINDER, SUN_PLATE
 from odpipe.environment.gravity import GravityField
 
-BODY_RADIUS = {"earth": 6378136.3, "moon": 1737400.0}  # m, for shadows
+BODY_RADIUS = {"earth": EGM96_RADIUS, "moon": MOON_RADIUS}  # m, for shadows
 ROTATION_GRID = {"earth": (3600.0, 12), "moon": (86400.0, 12)}  # s per segment, degree
 
 

@@ -10,7 +10,7 @@ from __future__ import annotations
 import numpy as np
 from numba import njit
 
-C_LIGHT = 299792458.0  # m/s
+from odpipe.constants import C_LIGHT
 
 
 @njit(cache=True)

@@ -23,7 +23,7 @@ from __future__ import annotations
 import numpy as np
 from numba import njit
 
-AU = 149597870700.0  # m
+from odpipe.constants import AU
 P_SUN_1AU = 4.56e-6  # N/m^2 at 1 AU (Montenbruck & Gill 2000)
 R_SUN = 6.96e8  # m, photospheric radius used for the shadow cones
 PLATE, SUN_PLATE, CYLINDER, SUN_CYLINDER = 0, 1, 2, 3

@@ -22,12 +22,11 @@ import numpy as np
 
 import astropy_iers_data
 from odpipe.environment.eop_tides import ocean_tide_eop
+from odpipe.constants import ARCSEC, MJD_UNIX, NS_PER_DAY, NS_PER_S, SECONDS_PER_DAY, TT_MINUS_TAI_NS
 from odpipe.numerics.interpolation import lagrange4_uniform, on_uniform_grid
-from odpipe.time.leap_seconds import NS_PER_DAY, tai_minus_utc_ns
+from odpipe.time.leap_seconds import tai_minus_utc_ns
 from odpipe.time.scales import as_utc_ns
 
-ARCSEC = np.pi / (180.0 * 3600.0)
-_MJD_UNIX = 40587
 _MJD_1972 = 41317
 _TIDE_GRID_DAYS = 1.0 / 96.0
 
@@ -63,7 +62,7 @@ class EOPTable:
         step = np.diff(mjd)
         if mjd.size < 4 or np.any(np.abs(step - 1.0) > 1e-9):
             raise ValueError(f"{source}: EOP rows must be daily and contiguous (at least 4)")
-        ns = np.round((mjd - _MJD_UNIX) * NS_PER_DAY).astype(np.int64)
+        ns = np.round((mjd - MJD_UNIX) * NS_PER_DAY).astype(np.int64)
         ut1_tai = np.asarray(ut1_utc, float) - tai_minus_utc_ns(ns) * 1e-9
         return cls(mjd, ut1_tai, np.asarray(xp, float), np.asarray(yp, float), np.asarray(dx, float),
                    np.asarray(dy, float), np.asarray(lod, float), source)
@@ -71,7 +70,7 @@ class EOPTable:
     @property
     def span(self) -> tuple[np.datetime64, np.datetime64]:
         """First and last tabulated epochs (UTC)."""
-        to = lambda m: np.datetime64(int(round((m - _MJD_UNIX) * 86400)), "s")  # noqa: E731
+        to = lambda m: np.datetime64(int(round((m - MJD_UNIX) * SECONDS_PER_DAY)), "s")  # noqa: E731
         return to(self.mjd[0]), to(self.mjd[-1])
 
     def at(self, epoch_utc, ocean_tides: bool = True) -> EOPValues:
@@ -81,7 +80,7 @@ class EOPTable:
         (IERS ORTHO_EOP, :mod:`odpipe.environment.eop_tides`), which daily series omit.
         """
         ns = as_utc_ns(epoch_utc)
-        mjd = ns / NS_PER_DAY + _MJD_UNIX
+        mjd = ns / NS_PER_DAY + MJD_UNIX
         bad = (mjd < self.mjd[0]) | (mjd > self.mjd[-1])
         if np.any(bad):
             first = np.datetime64(int(np.asarray(ns)[bad].ravel()[0]), "ns")
@@ -92,7 +91,8 @@ class EOPTable:
         dat = tai_minus_utc_ns(ns) * 1e-9
         ut1_utc, xp, yp = v[..., 0] + dat, v[..., 1], v[..., 2]
         if ocean_tides:
-            tides = on_uniform_grid(lambda d: np.stack(ocean_tide_eop(d), axis=-1), mjd + (dat + 32.184) / 86400.0,
+            tt_mjd = mjd + (dat + TT_MINUS_TAI_NS / NS_PER_S) / SECONDS_PER_DAY
+            tides = on_uniform_grid(lambda d: np.stack(ocean_tide_eop(d), axis=-1), tt_mjd,
                                     _TIDE_GRID_DAYS)  # shortest period ~0.5 d: grid error < 1e-5 relative
             dx, dy, dut1 = tides[..., 0], tides[..., 1], tides[..., 2]
             ut1_utc, xp, yp = ut1_utc + dut1 * 1e-6, xp + dx * 1e-6 * ARCSEC, yp + dy * 1e-6 * ARCSEC

@@ -42,9 +42,8 @@ from pathlib import Path
 import numpy as np
 from numba import njit
 
-from odpipe.time.scales import J2000_JD
+from odpipe.constants import J2000_JD, SECONDS_PER_DAY
 
-AU_M_DE440 = 149_597_870_700.0
 BODY_IDS: dict[str, int] = {
     "ssb": 0, "solar_system_barycenter": 0, "mercury": 1, "venus": 2, "emb": 3, "earth_barycenter": 3,
     "mars": 4, "jupiter": 5, "saturn": 6, "uranus": 7, "neptune": 8, "pluto": 9, "sun": 10,
@@ -58,7 +57,6 @@ _GM_DE440_KM3 = {
     10: 1.3271244004127942e11, 199: 2.2031868551400003e04, 299: 3.2485859200000000e05,
     301: 4.9028001184575496e03, 399: 3.9860043550702266e05,
 }
-_DAY = 86400.0
 _OPENED: dict[str, "Ephemeris"] = {}
 
 
@@ -69,8 +67,8 @@ def jd_split(t_tdb) -> tuple[np.ndarray, np.ndarray]:
     orbital motion at |t| = 3e9 s); the split keeps time to ~1e-12 s.
     """
     t = np.atleast_1d(np.asarray(t_tdb, dtype=float))
-    days = np.floor(t / _DAY)
-    return J2000_JD + days, (t - days * _DAY) / _DAY
+    days = np.floor(t / SECONDS_PER_DAY)
+    return J2000_JD + days, (t - days * SECONDS_PER_DAY) / SECONDS_PER_DAY
 
 
 def body_id(body) -> int:
@@ -181,7 +179,7 @@ class Ephemeris:
         from jplephem.ephem import Ephemeris as PackageEphemeris
         eph = PackageEphemeris(de421)
         lo, hi = float(eph.jalpha), float(eph.jomega)
-        origin = (lo - J2000_JD) * _DAY
+        origin = (lo - J2000_JD) * SECONDS_PER_DAY
 
         def series(name, scale=1.0):
             coeffs = eph.load(name)  # (sets, 3, ncoef) km, sets of equal length from jalpha
@@ -197,7 +195,7 @@ class Ephemeris:
         links[301] = _Link(3, series("moon", eph.moon_share).compute, lo, hi, origin)  # 'moon' is geocentric
         links[399] = _Link(3, series("moon", -eph.earth_share).compute, lo, hi, origin)
         au_km = float(eph.AU)
-        k = au_km**3 / _DAY**2 * 1e9  # AU^3/day^2 -> m^3/s^2
+        k = au_km**3 / SECONDS_PER_DAY**2 * 1e9  # AU^3/day^2 -> m^3/s^2
         gmb = float(eph.GMB) * k
         gm = {i: float(getattr(eph, f"GM{i}")) * k for i in (1, 2, 4, 5, 6, 7, 8, 9)}
         gm.update({3: gmb, 10: float(eph.GMS) * k, 399: gmb * eph.moon_share, 301: gmb * eph.earth_share})
@@ -224,8 +222,8 @@ class Ephemeris:
             lo, hi = (jd1 + jd2).min(), (jd1 + jd2).max()
             if lo < link.jd_start or hi > link.jd_end:
                 bad = lo if lo < link.jd_start else hi
-                raise ValueError(f"epoch TDB {(bad - J2000_JD) * _DAY:.3f} s past J2000 (JD {bad:.5f}) is outside "
-                                 f"{self.name} coverage of body {body} (JD {link.jd_start}..{link.jd_end})")
+                raise ValueError(f"epoch TDB {(bad - J2000_JD) * SECONDS_PER_DAY:.3f} s past J2000 (JD {bad:.5f}) "
+                                 f"is outside {self.name} coverage of body {body} (JD {link.jd_start}..{link.jd_end})")
             p, v = link.compute(jd1, jd2, velocity)
             pos += np.reshape(p, pos.shape)
             if velocity:
@@ -243,7 +241,7 @@ class Ephemeris:
         common = next(x for x in a if x in b)
         pa, va = self._sum_to(a, common, jd1, jd2, velocity)
         pb, vb = self._sum_to(b, common, jd1, jd2, velocity)
-        parts = [(pa - pb) * 1e3] + ([(va - vb) * (1e3 / _DAY)] if velocity else [])
+        parts = [(pa - pb) * 1e3] + ([(va - vb) * (1e3 / SECONDS_PER_DAY)] if velocity else [])
         return np.concatenate(parts).T
 
     def state(self, target, center, t_tdb) -> np.ndarray:
@@ -264,7 +262,8 @@ class Ephemeris:
     def coverage(self, body) -> tuple[float, float]:
         """(first, last) TDB s past J2000 at which ``body`` relative to the SSB is available."""
         links = [self._links[b] for b in self._chain(body_id(body))[:-1]]
-        return (max(lk.jd_start for lk in links) - J2000_JD) * _DAY, (min(lk.jd_end for lk in links) - J2000_JD) * _DAY
+        first, last = max(lk.jd_start for lk in links), min(lk.jd_end for lk in links)
+        return (first - J2000_JD) * SECONDS_PER_DAY, (last - J2000_JD) * SECONDS_PER_DAY
 
     def interpolant(self, bodies, center, t0: float, t1: float, piece_s: float = 43200.0,
                     ncoef: int = 14) -> "EphemerisInterpolant":
@@ -284,9 +283,10 @@ class Ephemeris:
         # small fraction, so the file is sampled at the nodes themselves (TDB seconds near 3e8 s
         # round to 6e-8 s: 2 mm of the Earth's barycentric motion)
         starts = t0 + piece_s * np.arange(npiece)
-        days = np.floor(starts / _DAY)
+        days = np.floor(starts / SECONDS_PER_DAY)
         jd1 = np.repeat(J2000_JD + days, ncoef)
-        jd2 = (((starts - days * _DAY)[:, None] + 0.5 * piece_s * (x[None, :] + 1.0)) / _DAY).ravel()
+        jd2 = ((starts - days * SECONDS_PER_DAY)[:, None] + 0.5 * piece_s * (x[None, :] + 1.0)) / SECONDS_PER_DAY
+        jd2 = jd2.ravel()
         basis = np.cos(np.pi * np.outer(k, k + 0.5) / ncoef) * (2.0 / ncoef)  # (coef j, node)
         basis[0] *= 0.5
         coeffs = np.empty((len(ids), npiece, 3, ncoef))

@@ -26,12 +26,8 @@ from pathlib import Path
 
 import numpy as np
 
+from odpipe.constants import DAYS_PER_JULIAN_YEAR, EGM96_GM, EGM96_RADIUS, SECONDS_PER_DAY
 from parsers import ParseError
-
-EGM96_GM = 3.986004415e14  # m^3/s^2, EGM96 (Lemoine et al. 1998)
-EGM96_RADIUS = 6378136.3  # m
-_J2000_DAYS_FROM_MJD = 51544.5
-_YEAR_DAYS = 365.25
 
 
 @dataclass
@@ -155,7 +151,7 @@ def _read_icgem(path: Path, lines: list[str], epoch: float | None) -> GravityFie
     if norm != "fully_normalized":
         raise ParseError(path, f"normalization {norm!r} not supported (fully_normalized only)")
     version2 = head.get("format", "").split()[:1] == ["icgem2.0"]
-    t_days = None if epoch is None else epoch / 86400.0
+    t_days = None if epoch is None else epoch / SECONDS_PER_DAY
     coeffs = _Coefficients(path)
     last_t0: dict[tuple[int, int], float] = {}
     for k in range(i + 1, len(lines)):
@@ -196,7 +192,7 @@ def _read_icgem(path: Path, lines: list[str], epoch: float | None) -> GravityFie
                 raise ParseError(path, f"{key} before its gfct", line=lineno)
             t0 = last_t0[(n, m)]
             period = extra[0] if key in ("acos", "asin") and extra else None
-        dt_years = (t_days - t0) / _YEAR_DAYS
+        dt_years = (t_days - t0) / DAYS_PER_JULIAN_YEAR
         if key == "gfct":
             factor = 1.0
         elif key in ("trnd", "dot"):

@@ -15,13 +15,13 @@ from __future__ import annotations
 
 import numpy as np
 
-from odpipe.time.leap_seconds import NS_PER_DAY, tai_minus_utc_ns
-from odpipe.time.scales import J2000_NS, TT_MINUS_TAI_NS, as_utc_ns
+from odpipe.constants import DAYS_PER_JULIAN_CENTURY, IERS2010_EARTH_RADIUS, J2000_NS, NS_PER_DAY, TT_MINUS_TAI_NS
+from odpipe.time.leap_seconds import tai_minus_utc_ns
+from odpipe.time.scales import as_utc_ns
 
 H20, L20, H3, L3 = 0.6078, 0.0847, 0.292, 0.015  # nominal Love and Shida numbers (TN36 §7.1.1)
 MASS_RATIO_SUN = 332946.0482
 MASS_RATIO_MOON = 0.0123000371
-RE = 6378136.6  # m
 
 # Table 7.3a: multipliers of (s, h, p, N', ps) added to tau, then ΔR in-phase, ΔR out-of-phase,
 # ΔT in-phase, ΔT out-of-phase (mm)
@@ -71,7 +71,7 @@ def solid_earth_tide(r_station, r_sun, r_moon, epoch_utc) -> np.ndarray:
     x = np.asarray(r_station, float)
     rs = np.stack(np.broadcast_arrays(np.asarray(r_sun, float), np.asarray(r_moon, float)), axis=0)  # (2, …, 3)
     utc = as_utc_ns(epoch_utc)
-    tt_cent = (utc + tai_minus_utc_ns(utc) + TT_MINUS_TAI_NS - J2000_NS) / NS_PER_DAY / 36525.0
+    tt_cent = (utc + tai_minus_utc_ns(utc) + TT_MINUS_TAI_NS - J2000_NS) / NS_PER_DAY / DAYS_PER_JULIAN_CENTURY
     ut_hours = np.mod(utc, NS_PER_DAY) / 3.6e12
 
     r = np.linalg.norm(x, axis=-1)
@@ -85,8 +85,8 @@ def solid_earth_tide(r_station, r_sun, r_moon, epoch_utc) -> np.ndarray:
     rb = np.linalg.norm(rs, axis=-1)                       # (2, …)
     unit_b = rs / rb[..., None]
     mass = np.array([MASS_RATIO_SUN, MASS_RATIO_MOON]).reshape((2,) + (1,) * (rb.ndim - 1))
-    fac2 = mass * RE * (RE / rb) ** 3
-    fac3 = fac2 * (RE / rb)
+    fac2 = mass * IERS2010_EARTH_RADIUS * (IERS2010_EARTH_RADIUS / rb) ** 3
+    fac3 = fac2 * (IERS2010_EARTH_RADIUS / rb)
 
     # step 1, in phase, degrees 2 and 3 (eqs. 7.5, 7.6) with latitude-dependent h2, l2
     sc = np.sum(unit_b * (x / r[..., None]), axis=-1)

@@ -24,10 +24,11 @@ import erfa
 import numpy as np
 import pandas as pd
 
+from odpipe.constants import DAYS_PER_JULIAN_YEAR, J2000, SECONDS_PER_DAY
 from odpipe.frames.epochs import utc_and_tt
 
 CATALOG_FILE = Path(__file__).parent / "data" / "stations.csv"
-JULIAN_YEAR_S = 365.25 * 86400.0
+JULIAN_YEAR_S = DAYS_PER_JULIAN_YEAR * SECONDS_PER_DAY
 WGS84 = 1  # ERFA ellipsoid id
 GRS80 = 2
 
@@ -37,7 +38,7 @@ def _calendar_year_s(year: float) -> float:
     y = int(np.floor(year))
     start = np.datetime64(f"{y:04d}-01-01T00:00:00", "s")
     length = (np.datetime64(f"{y + 1:04d}-01-01", "s") - start).astype(float)
-    t = (start - np.datetime64("2000-01-01T12:00:00", "s")).astype(float)
+    t = (start - J2000.astype("datetime64[s]")).astype(float)
     return t + (year - y) * length
 
 
@@ -85,8 +86,8 @@ class Station:
             return self.r_itrs.copy()
         arr = np.asarray(t)
         # TDB seconds stand for TT here: 2 ms apart, nothing at plate-motion rates (cm/yr)
-        tt_days = arr / 86400.0 if arr.dtype.kind in "fiu" else utc_and_tt(arr)[1]
-        years = (np.asarray(tt_days) * 86400.0 - _calendar_year_s(self.epoch_year)) / JULIAN_YEAR_S
+        tt_days = arr / SECONDS_PER_DAY if arr.dtype.kind in "fiu" else utc_and_tt(arr)[1]
+        years = (np.asarray(tt_days) * SECONDS_PER_DAY - _calendar_year_s(self.epoch_year)) / JULIAN_YEAR_S
         return self.r_itrs + np.asarray(years)[..., None] * self.v_itrs_per_yr
 
     def geodetic(self, ellipsoid: int = WGS84):

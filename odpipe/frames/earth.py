@@ -21,10 +21,9 @@ from odpipe.environment.eop import EOPValues, eop_at
 from odpipe.numerics.interpolation import on_uniform_grid
 from odpipe.frames.epochs import utc_and_tt
 from odpipe.frames.rotations import frame_rotation
-from odpipe.time.leap_seconds import NS_PER_DAY, tai_minus_utc_ns
-from odpipe.time.scales import J2000_JD, J2000_NS
+from odpipe.constants import ERA_RATE, J2000_JD, J2000_NS, NS_PER_DAY, SECONDS_PER_DAY
+from odpipe.time.leap_seconds import tai_minus_utc_ns
 
-ERA_RATE = 2.0 * np.pi * 1.00273781191135448 / 86400.0  # rad per UT1 second (IERS 2010 eq. 5.15)
 CIP_GRID_STEP_DAYS = 1.0 / 24.0
 _CIP_GRID_MIN_EPOCHS = 200
 
@@ -84,12 +83,12 @@ def earth_rotation(t, eop: EOPValues | None = None, with_rate: bool = False) -> 
     sp = erfa.sp00(J2000_JD, tt_days)
     rpom = erfa.pom00(e.xp, e.yp, sp)
     days, rem_ns = np.divmod(utc - J2000_NS, NS_PER_DAY)  # whole + fraction keeps ERA at 1e-16 rad
-    era = erfa.era00(J2000_JD + days, rem_ns / NS_PER_DAY + e.ut1_utc / 86400.0)
-    omega = ERA_RATE * (1.0 - e.lod / 86400.0)
+    era = erfa.era00(J2000_JD + days, rem_ns / NS_PER_DAY + e.ut1_utc / SECONDS_PER_DAY)
+    omega = ERA_RATE * (1.0 - e.lod / SECONDS_PER_DAY)
     rc2i_rate = rpom_rate = None
     if with_rate:
         h = _RATE_STEP_DAYS
-        rc2i_rate = (_rc2i(tt_days + h, e.dx, e.dy) - _rc2i(tt_days - h, e.dx, e.dy)) / (2 * h * 86400.0)
+        rc2i_rate = (_rc2i(tt_days + h, e.dx, e.dy) - _rc2i(tt_days - h, e.dx, e.dy)) / (2 * h * SECONDS_PER_DAY)
         if eop is None:
             step = np.int64(_EOP_RATE_STEP_S * 1e9)
             ep = eop_at((utc + step).astype("datetime64[ns]"))

@@ -4,8 +4,9 @@ from __future__ import annotations
 
 import numpy as np
 
-from odpipe.time.leap_seconds import NS_PER_DAY, tai_minus_utc_ns
-from odpipe.time.scales import J2000_NS, TT_MINUS_TAI_NS, as_utc_ns, tdb_to_tt_seconds, tdb_to_utc
+from odpipe.constants import J2000_NS, NS_PER_DAY, SECONDS_PER_DAY, TT_MINUS_TAI_NS
+from odpipe.time.leap_seconds import tai_minus_utc_ns
+from odpipe.time.scales import as_utc_ns, tdb_to_tt_seconds, tdb_to_utc
 
 
 def utc_and_tt(t) -> tuple[np.ndarray, np.ndarray]:
@@ -20,4 +21,4 @@ def utc_and_tt(t) -> tuple[np.ndarray, np.ndarray]:
         return utc, tt_ns / NS_PER_DAY
     if arr.dtype.kind not in "fiu":
         raise TypeError(f"epochs must be datetime64 UTC or float TDB seconds, got dtype {arr.dtype}")
-    return as_utc_ns(tdb_to_utc(arr)), tdb_to_tt_seconds(arr) / 86400.0
+    return as_utc_ns(tdb_to_utc(arr)), tdb_to_tt_seconds(arr) / SECONDS_PER_DAY

@@ -22,10 +22,10 @@ from pathlib import Path
 
 import numpy as np
 
+from odpipe.constants import ARCSEC, DAYS_PER_JULIAN_CENTURY, SECONDS_PER_DAY
 from odpipe.environment.ephemeris import jd_split
 from odpipe.frames.rotations import frame_rotation
 
-ARCSEC = np.pi / (180.0 * 3600.0)
 _DEG = np.pi / 180.0
 # MOON_ME_DE421 relative to MOON_PA_DE421 (NAIF moon_080317.tf, TKFRAME_31007), arcsec, axes (3, 2, 1)
 ME_DE421_ANGLES_ARCSEC = (67.92, 78.56, 0.30)
@@ -91,8 +91,8 @@ _PM = (38.3213, 13.17635815, -1.4e-12, np.array([3.5610, 0.1208, -0.0642, 0.0158
 def moon_iau_to_icrf(t_tdb) -> np.ndarray:
     """Rotation matrices IAU_MOON → ICRF (IAU 2009 model) at TDB s past J2000."""
     t = np.asarray(t_tdb, dtype=float)
-    d = t / 86400.0
-    cent = d / 36525.0
+    d = t / SECONDS_PER_DAY
+    cent = d / DAYS_PER_JULIAN_CENTURY
     e = (_E_ANGLES[:, 0] + _E_ANGLES[:, 1] * cent[..., None]) * _DEG
     ra = _RA[0] + _RA[1] * cent + np.sin(e) @ _RA[2]
     dec = _DEC[0] + _DEC[1] * cent + np.cos(e) @ _DEC[2]

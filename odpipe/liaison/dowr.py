@@ -46,7 +46,7 @@ from odpipe.environment.gravity import read_gravity
 from odpipe.estimation.fit import FitOptions, Observations, build_grid, fit
 from odpipe.estimation.registry import GaussMarkov, ParameterRegistry
 from odpipe.measurements import MeasurementSetup, compute
-from odpipe.measurements.bands import C_LIGHT
+from odpipe.constants import C_LIGHT
 from odpipe.measurements.crosslink import ClockModel
 from odpipe.od.problem import TrackingProblem
 from odpipe.time import utc_to_tdb

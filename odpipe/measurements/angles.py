@@ -16,12 +16,12 @@ from __future__ import annotations
 
 import numpy as np
 
+from odpipe.constants import WGS84_A, WGS84_F
 from odpipe.environment.stations import enu_matrix, itrs_to_geodetic
 
 from .computed import Computed, EventPartial
 
 KINDS = ("azimuth", "elevation", "x", "y")
-_WGS84_A, _WGS84_F = 6378137.0, 1 / 298.257223563
 
 
 def _axes_turn(lat, lon, h, d_itrs):
@@ -31,9 +31,9 @@ def _axes_turn(lat, lon, h, d_itrs):
     east = np.stack([-so, co, z], -1)
     north = np.stack([-sl * co, -sl * so, cl], -1)
     up = np.stack([cl * co, cl * so, sl], -1)
-    e2 = _WGS84_F * (2 - _WGS84_F)
+    e2 = WGS84_F * (2 - WGS84_F)
     w = np.sqrt(1 - e2 * sl**2)
-    m_rad, n_rad = _WGS84_A * (1 - e2) / w**3 + h, _WGS84_A / w + h
+    m_rad, n_rad = WGS84_A * (1 - e2) / w**3 + h, WGS84_A / w + h
     dot = lambda a: np.einsum("ni,ni->n", a, d_itrs)  # noqa: E731
     dw_dlat = np.stack([z, -dot(up), dot(north)], -1)
     dw_dlon = np.stack([dot(sl[:, None] * north - cl[:, None] * up), -sl * dot(east), cl * dot(east)], -1)

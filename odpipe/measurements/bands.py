@@ -1,4 +1,4 @@
-"""Radio bands: the speed of light, transponder turnaround ratios and range-unit factors.
+"""Radio bands: transponder turnaround ratios and range-unit factors.
 
 Facts from Moyer, *Formulation for Observed and Computed Values of Deep Space
 Network Data Types for Navigation* (DESCANSO Monograph 2), chapter 13, and the
@@ -15,8 +15,6 @@ DSN Telecommunications Link Design Handbook (810-005):
 from __future__ import annotations
 
 import numpy as np
-
-C_LIGHT = 299_792_458.0  # m/s, exact
 
 # (uplink band, downlink band) -> M2 = f_down / f_up
 TURNAROUND = {

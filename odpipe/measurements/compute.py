@@ -52,12 +52,13 @@ from typing import Callable, Mapping
 import numpy as np
 import pandas as pd
 
+from odpipe.constants import C_LIGHT, SECONDS_PER_DAY
 from odpipe.environment.ephemeris import SpanEphemeris
 from odpipe.frames.tabulated import TabulatedRotation
 from odpipe.tracking.timetags import interval_bounds
 
 from . import angles, crosslink, dsn, instantaneous, refraction
-from .bands import C_LIGHT, ONE_WAY_SCALE, band_name, range_unit_factor, turnaround_ratio
+from .bands import ONE_WAY_SCALE, band_name, range_unit_factor, turnaround_ratio
 from .computed import Computed, ConstantUplink
 from .lighttime import anchor_from_utc, solve_path
 from .nodes import SpacecraftNode, StationNode, proper_rate_offset
@@ -144,7 +145,7 @@ def compute(rows: pd.DataFrame, trajectories: Mapping, setup: MeasurementSetup) 
     return out
 
 
-SPAN_MARGIN_S = 86400.0  # s around the rows' epochs: light times (hours) and count intervals
+SPAN_MARGIN_S = SECONDS_PER_DAY  # s around the rows' epochs: light times (hours) and count intervals
 
 
 def spanning(setup: MeasurementSetup, t0: float, t1: float) -> MeasurementSetup:

@@ -24,7 +24,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from .bands import C_LIGHT
+from odpipe.constants import C_LIGHT
+
 from .computed import Computed, EventPartial
 
 

@@ -37,7 +37,8 @@ from __future__ import annotations
 
 import numpy as np
 
-from .bands import C_LIGHT
+from odpipe.constants import C_LIGHT
+
 from .computed import Computed, EventPartial
 
 _ROLES = ("station_tx", "spacecraft", "station_rx")

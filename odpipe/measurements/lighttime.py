@@ -46,7 +46,8 @@ from typing import Sequence
 import numba
 import numpy as np
 
-from .bands import C_LIGHT
+from odpipe.constants import C_LIGHT
+
 from .nodes import origin_state
 
 _MAXITER = 12

@@ -26,11 +26,8 @@ from typing import Callable, Protocol
 import numpy as np
 from scipy.interpolate import CubicSpline
 
+from odpipe.constants import C_LIGHT, ERA_RATE
 from odpipe.time import tdb_minus_tt
-
-from .bands import C_LIGHT
-
-EARTH_ROTATION_RATE = 7.292115146706979e-5  # rad/s, IERS nominal (used for the station velocity only)
 
 
 class Node(Protocol):
@@ -119,7 +116,7 @@ class StationNode:
         t = np.atleast_1d(np.asarray(t, dtype=float))
         r = self.itrs(t)
         rot = self.itrs_to_frame(t)
-        w = np.cross(np.array([0.0, 0.0, EARTH_ROTATION_RATE]), r)
+        w = np.cross(np.array([0.0, 0.0, ERA_RATE]), r)
         return np.concatenate([np.einsum("nij,nj->ni", rot, r), np.einsum("nij,nj->ni", rot, w)], axis=1)
 
     def state(self, t):

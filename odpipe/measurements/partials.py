@@ -13,10 +13,11 @@ from __future__ import annotations
 
 import numpy as np
 
-from .computed import Computed
-from .nodes import EARTH_ROTATION_RATE
+from odpipe.constants import ERA_RATE
 
-_OMEGA_CROSS = np.array([[0.0, -EARTH_ROTATION_RATE, 0.0], [EARTH_ROTATION_RATE, 0.0, 0.0], [0.0, 0.0, 0.0]])
+from .computed import Computed
+
+_OMEGA_CROSS = np.array([[0.0, -ERA_RATE, 0.0], [ERA_RATE, 0.0, 0.0], [0.0, 0.0, 0.0]])
 
 
 def event_gradient(computed: Computed, role: str) -> list[tuple[np.ndarray, np.ndarray]]:

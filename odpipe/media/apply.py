@@ -34,8 +34,9 @@ from __future__ import annotations
 import numpy as np
 import pandas as pd
 
+from odpipe.constants import C_LIGHT
 from odpipe.environment.stations import StationCatalog, itrs_to_geodetic, topocentric
-from odpipe.measurements.bands import C_LIGHT, range_unit_factor
+from odpipe.measurements.bands import range_unit_factor
 from odpipe.media import mendes_pavlis, saastamoinen
 from odpipe.media.model import MediaModel
 from odpipe.media.smoothing import smooth_by_group

@@ -13,10 +13,11 @@ from __future__ import annotations
 
 import numpy as np
 
+from odpipe.constants import SECONDS_PER_DAY
 from parsers.ionex import IonexMaps
 
 K_IONO = 40.3e16          # m^3/s^2 per TECU: delay = K_IONO * TEC[TECU] / f^2
-_DEG_PER_S = 360.0 / 86400.0
+_DEG_PER_S = 360.0 / SECONDS_PER_DAY
 
 
 def group_delay(tec_tecu, frequency_hz):

@@ -12,6 +12,8 @@ from __future__ import annotations
 
 import numpy as np
 
+from odpipe.constants import DAYS_PER_JULIAN_YEAR
+
 _LAT = np.radians([15.0, 30.0, 45.0, 60.0, 75.0])
 _HYD_AVG = np.array([
     [1.2769934e-3, 1.2683230e-3, 1.2465397e-3, 1.2196049e-3, 1.2045996e-3],
@@ -42,8 +44,8 @@ def _at_latitude(table, lat):
 def hydrostatic(elevation, latitude, height_m, doy):
     """Niell hydrostatic mapping function (elevation, geodetic latitude in rad; height m; day of year)."""
     lat = np.asarray(latitude, dtype=float)
-    phase = np.where(lat < 0, 365.25 / 2, 0.0)
-    season = np.cos(2 * np.pi * (np.asarray(doy, dtype=float) - 28.0 + phase) / 365.25)
+    phase = np.where(lat < 0, DAYS_PER_JULIAN_YEAR / 2, 0.0)
+    season = np.cos(2 * np.pi * (np.asarray(doy, dtype=float) - 28.0 + phase) / DAYS_PER_JULIAN_YEAR)
     avg, amp = _at_latitude(_HYD_AVG, lat), _at_latitude(_HYD_AMP, lat)
     a, b, c = (m - s * season for m, s in zip(avg, amp))
     dm = (1.0 / np.sin(elevation) - continued_fraction(elevation, *_HEIGHT)) * np.asarray(height_m) * 1e-3

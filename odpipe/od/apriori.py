@@ -39,10 +39,10 @@ import numpy as np
 import pandas as pd
 from scipy.optimize import least_squares
 
+from odpipe.constants import C_LIGHT
 from odpipe.dynamics.forces import ForceModel
 from odpipe.dynamics.propagator import propagate
 from odpipe.measurements import MeasurementSetup, compute, residuals
-from odpipe.measurements.bands import C_LIGHT
 from odpipe.preprocess.compress import compress
 from odpipe.preprocess.edit import EditConfig, edit
 from odpipe.preprocess.flags import Flag, set_flag

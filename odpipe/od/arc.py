@@ -20,6 +20,7 @@ from dataclasses import dataclass, field, replace
 import numpy as np
 import pandas as pd
 
+from odpipe.constants import SECONDS_PER_DAY
 from odpipe.dynamics.forces import ForceModel, SolarRadiationPressure
 from odpipe.estimation.fit import EDIT_INNOVATION, NONFINITE, FitOptions, Observations, Solution, build_grid, fit
 from odpipe.estimation.maneuvers import maneuver_table
@@ -267,8 +268,8 @@ def growing_ends(setup: ArcSetup) -> list[float]:
     if not setup.growing_days:
         return []
     ends, d = [], setup.growing_days
-    while setup.start + d * 86400.0 < setup.end - 0.5 * d * 86400.0:
-        ends.append(setup.start + d * 86400.0)
+    while setup.start + d * SECONDS_PER_DAY < setup.end - 0.5 * d * SECONDS_PER_DAY:
+        ends.append(setup.start + d * SECONDS_PER_DAY)
         d *= 2.0
     return ends
 

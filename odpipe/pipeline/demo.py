@@ -26,6 +26,7 @@ import pandas as pd
 
 from odpipe.analysis import maneuvers as maneuver_report
 from odpipe.analysis import overlap
+from odpipe.constants import J2000, SECONDS_PER_DAY
 from odpipe.dynamics.compile_timer import compile_timer
 from odpipe.pipeline.run import run_config
 from odpipe.products.atomic import write_text
@@ -40,7 +41,6 @@ from parsers.maneuvers import read_plan
 
 CASE = Path(__file__).resolve().parents[2] / "runs" / "artemis_p2_like.toml"
 HOUR = 3600.0
-J2000 = np.datetime64("2000-01-01T12:00:00", "ns")   # TDB epoch of the OEM time tags (TDB s past J2000)
 OFFSET = np.array([1000.0, -800.0, 600.0, 0.01, -0.01, 0.005])  # a priori displacement, m and m/s
 
 
@@ -49,7 +49,7 @@ def arcs(start: float, end: float, sk: list[float]) -> list[tuple[str, str, floa
     sk = sorted(sk)
     out = []
     for k, (a, b) in enumerate(zip(sk[:-1], sk[1:])):  # short arcs: both ends of each maneuver interval
-        span = min(5 * 86400.0, (b - a) - 2 * HOUR)
+        span = min(5 * SECONDS_PER_DAY, (b - a) - 2 * HOUR)
         out += [(f"short{k}a", "short", a + HOUR, a + HOUR + span), (f"short{k}b", "short", b - HOUR - span, b - HOUR)]
     edges = [start] + sk + [end]
     for k in range(len(edges) - 2):  # long arcs: from after one maneuver to before the one after next

@@ -20,11 +20,11 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 
+from odpipe.constants import C_LIGHT
 from odpipe.environment.stations import topocentric
 from odpipe.frames.earth import gcrs_to_itrs
 from odpipe.time import tdb_to_utc, utc_to_tdb
 
-C_LIGHT = 299_792_458.0
 RUN_TRAJECTORY = "trajectory.oem"
 
 

@@ -11,11 +11,11 @@ from datetime import datetime, timezone
 
 import numpy as np
 
+from odpipe.constants import J2000
 from odpipe.products.atomic import write_text
 from odpipe.products.segments import EphemerisSegment
 from odpipe.time import tdb_to_utc
 
-J2000_TDB = np.datetime64("2000-01-01T12:00:00", "ns")
 _TRIL = np.tril_indices(6)
 
 
@@ -27,7 +27,7 @@ def epoch_strings(t_tdb, time_system: str = "TDB") -> list[str]:
         # The TDB calendar has no leap seconds: plain arithmetic from J2000.
         whole = np.floor(t_tdb)
         ns = (whole.astype(np.int64) * 1_000_000_000 + np.round((t_tdb - whole) * 1e9).astype(np.int64))
-        epochs = J2000_TDB + ns.astype("timedelta64[ns]")
+        epochs = J2000 + ns.astype("timedelta64[ns]")
     elif time_system == "UTC":
         epochs = np.asarray(tdb_to_utc(t_tdb), dtype="datetime64[ns]")
     else:

@@ -21,7 +21,8 @@ import pandas as pd
 
 from odpipe.measurements import compute
 from odpipe.media.apply import calibrate
-from odpipe.simulate.schedule import NS, StateOnly, passes, sample_epochs
+from odpipe.constants import NS_PER_S
+from odpipe.simulate.schedule import StateOnly, passes, sample_epochs
 from parsers.ramps import RampStore
 from parsers.table import RAMP_COLUMNS, build
 
@@ -48,7 +49,7 @@ def _rows(net, sc, epochs, observable, pass_id, unit, count):
 
 
 def _ramp(net, window, rng) -> dict:
-    start = window[0] - np.timedelta64(3600 * NS, "ns")
+    start = window[0] - np.timedelta64(3600 * NS_PER_S, "ns")
     return {"station": net.station, "start": start, "end": window[1], "freq_hz": net.uplink_hz + 1e3 * rng.standard_normal(),
             "rate_hz_s": net.ramp_rate_sigma * rng.standard_normal(), "band": net.band, "source": "simulated", "record": -1}
 

@@ -13,11 +13,11 @@ from __future__ import annotations
 
 import numpy as np
 
+from odpipe.constants import NS_PER_DAY, NS_PER_S
 from odpipe.measurements import compute
 from parsers.table import build
 
 GRID_S = 60
-NS = 1_000_000_000
 
 
 class StateOnly:
@@ -39,14 +39,14 @@ def passes(traj, setup, net, spacecraft: str, start: np.datetime64, end: np.date
     """Pass windows [(start, end) datetime64[ns]] of one network rule."""
     mask = np.radians(net.mask_deg)
     out = []
-    day = np.timedelta64(86400 * NS, "ns")
+    day = np.timedelta64(NS_PER_DAY, "ns")
     k = 0
     while True:
-        d0 = start + np.timedelta64(int((net.offset_days + k * net.every_days) * 86400 * NS), "ns")
+        d0 = start + np.timedelta64(int((net.offset_days + k * net.every_days) * NS_PER_DAY), "ns")
         k += 1
         if d0 >= end:
             return out
-        grid = np.arange(d0, min(d0 + day, end), np.timedelta64(GRID_S * NS, "ns"))
+        grid = np.arange(d0, min(d0 + day, end), np.timedelta64(GRID_S * NS_PER_S, "ns"))
         up = elevation(traj, setup, net.station, spacecraft, grid) > mask
         if not up.any():
             continue
@@ -54,7 +54,7 @@ def passes(traj, setup, net, spacecraft: str, start: np.datetime64, end: np.date
         runs = edges.reshape(-1, 2)
         a, b = runs[np.argmax(runs[:, 1] - runs[:, 0])]
         rise, set_ = grid[a], grid[b - 1]
-        length = np.timedelta64(int(net.pass_s * NS), "ns")
+        length = np.timedelta64(int(net.pass_s * NS_PER_S), "ns")
         span = set_ - rise
         if net.passes == 1:
             mid = rise + (span - min(length, span)) // 2
@@ -71,5 +71,5 @@ def passes(traj, setup, net, spacecraft: str, start: np.datetime64, end: np.date
 
 def sample_epochs(window: tuple, step_s: float) -> np.ndarray:
     """Epochs step_s apart from window start + step_s to the window end (interval ends / receptions)."""
-    step = np.timedelta64(int(round(step_s * NS)), "ns")
+    step = np.timedelta64(int(round(step_s * NS_PER_S)), "ns")
     return np.arange(window[0] + step, window[1] + np.timedelta64(1, "ns"), step)

@@ -18,6 +18,7 @@ from dataclasses import replace
 import numpy as np
 from scipy.optimize import brentq
 
+from odpipe.constants import SECONDS_PER_DAY
 from odpipe.dynamics import propagate
 from odpipe.simulate.libration import icrf_to_rotating
 
@@ -44,7 +45,8 @@ def crossing_vx(force_model, state, t: float, gap: float, horizon: float) -> flo
     return float(rot(np.array([tc]))[0, 3])
 
 
-def design_dv(force_model, state, t: float, gaps=(7 * 86400.0,), horizon: float = 8 * 86400.0) -> np.ndarray:
+def design_dv(force_model, state, t: float, gaps=(7 * SECONDS_PER_DAY,), horizon: float = 8 * SECONDS_PER_DAY
+              ) -> np.ndarray:
     """ICRF delta-v (3,) m/s at TDB ``t``: the crossing design of the first of ``gaps`` (s) that converges."""
     for gap in gaps:
         dv = _crossing_dv(force_model, state, t, gap, gap + horizon)

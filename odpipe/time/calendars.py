@@ -9,7 +9,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from odpipe.time.leap_seconds import NS_PER_DAY, NS_PER_S
+from odpipe.constants import NS_PER_DAY, NS_PER_S
 
 ODF_ORIGIN = np.datetime64("1950-01-01T00:00:00", "ns")
 

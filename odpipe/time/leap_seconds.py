@@ -14,9 +14,7 @@ import numpy as np
 
 import astropy_iers_data
 
-NS_PER_S = 1_000_000_000
-NS_PER_DAY = 86_400 * NS_PER_S
-_MJD_UNIX = 40587  # MJD of 1970-01-01, the datetime64 origin
+from odpipe.constants import MJD_UNIX, NS_PER_DAY, NS_PER_S
 
 
 def leap_second_file() -> Path:
@@ -38,7 +36,7 @@ def leap_second_table() -> tuple[np.ndarray, np.ndarray]:
         raise ValueError(f"no leap-second rows in {path}")
     mjd = np.array([r[0] for r in rows], dtype=np.int64)
     dat = np.array([r[1] for r in rows], dtype=np.int64)
-    return (mjd - _MJD_UNIX) * NS_PER_DAY, dat
+    return (mjd - MJD_UNIX) * NS_PER_DAY, dat
 
 
 def _first_error(ns: np.ndarray, bad: np.ndarray, what: str) -> ValueError:

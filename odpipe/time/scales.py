@@ -18,14 +18,10 @@ from __future__ import annotations
 import erfa
 import numpy as np
 
+from odpipe.constants import (GPS_MINUS_TAI_NS, GPS_ORIGIN_NS, J2000_JD, J2000_NS, NS_PER_DAY, NS_PER_S,
+                              SECONDS_PER_DAY, TT_MINUS_TAI_NS)
 from odpipe.numerics.interpolation import lagrange4_uniform
-from odpipe.time.leap_seconds import NS_PER_DAY, NS_PER_S, tai_minus_utc_ns, utc_ns_from_tai_ns
-
-TT_MINUS_TAI_NS = 32_184_000_000
-GPS_MINUS_TAI_NS = -19 * NS_PER_S
-J2000_NS = np.datetime64("2000-01-01T12:00:00", "ns").astype(np.int64)  # on any scale's own calendar
-GPS_ORIGIN_NS = np.datetime64("1980-01-06T00:00:00", "ns").astype(np.int64)
-J2000_JD = 2451545.0
+from odpipe.time.leap_seconds import tai_minus_utc_ns, utc_ns_from_tai_ns
 
 
 def as_utc_ns(epoch_utc) -> np.ndarray:
@@ -119,8 +115,8 @@ def tdb_minus_tt(t_tdb, station_itrs=None) -> np.ndarray:
     terms (≈2 µs diurnal); by default the geocentric value is returned.
     """
     t = np.asarray(t_tdb, dtype=float)
-    ut_frac = np.mod(t / 86400.0 + 0.5, 1.0)  # UT ≈ TDB to ~70 s: enough for the µs topocentric term
-    return _dtdb(t / 86400.0, ut_frac, station_itrs)
+    ut_frac = np.mod(t / SECONDS_PER_DAY + 0.5, 1.0)  # UT ≈ TDB to ~70 s: enough for the µs topocentric term
+    return _dtdb(t / SECONDS_PER_DAY, ut_frac, station_itrs)
 
 
 def utc_to_tdb2(epoch_utc, station_itrs=None) -> tuple[np.ndarray, np.ndarray]:

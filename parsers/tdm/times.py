@@ -15,10 +15,12 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 
+from odpipe.constants import GPS_MINUS_TAI_NS, MJD_ORIGIN, NS_PER_DAY, NS_PER_S, TT_MINUS_TAI_NS
+
 EPOCH = r"^\d{4}-(\d{2}-\d{2}|\d{3})T\d{2}:\d{2}:\d{2}(\.\d+)?$"
 
 # Seconds to add to TAI to get each scale.
-_FROM_TAI = {"TAI": 0.0, "GPS": -19.0, "TT": 32.184}
+_FROM_TAI = {"TAI": 0.0, "GPS": GPS_MINUS_TAI_NS / NS_PER_S, "TT": TT_MINUS_TAI_NS / NS_PER_S}
 LEAP_SCALES = set(_FROM_TAI)
 
 
@@ -57,7 +59,7 @@ def _leap_table() -> tuple[np.ndarray, np.ndarray]:
     path = Path(list(spec.submodule_search_locations)[0]) / "data" / "Leap_Second.dat"
     rows = np.loadtxt(path, comments="#")
     mjd, step = rows[:, 0], rows[:, 4]
-    start = (np.datetime64("1858-11-17", "ns") + (mjd * 86400e9).astype("timedelta64[ns]"))
+    start = (MJD_ORIGIN + (mjd * NS_PER_DAY).astype("timedelta64[ns]"))
     return start, step
 
 

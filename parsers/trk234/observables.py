@@ -40,6 +40,7 @@ from __future__ import annotations
 import numpy as np
 import pandas as pd
 
+from odpipe.constants import SECONDS_PER_DAY
 from parsers import table as tt
 from parsers.trk234 import layout
 from parsers.trk234.sfdu import Block
@@ -171,7 +172,7 @@ def _rows(block: Block) -> list[dict]:
             return []
         obs = r["obs"]
         spacing = r["obs_cnt_time"].astype(np.float64)
-        spacing = np.where(np.isfinite(spacing) & (np.abs(spacing) < 86400.0), spacing, np.nan)
+        spacing = np.where(np.isfinite(spacing) & (np.abs(spacing) < SECONDS_PER_DAY), spacing, np.nan)
         step = pd.to_timedelta((np.arange(n) * spacing[:, None]).ravel(), unit="s").to_numpy().reshape(-1, n)
         rep = {k: np.repeat(np.asarray(v), n) if np.ndim(v) else v for k, v in base.items()}
         rep["epoch"] = (base["epoch"][:, None] + step).ravel()
