@@ -31,7 +31,7 @@ import pandas as pd  # noqa: E402
 from odpipe.analysis.overlap import compare, oem_trajectory  # noqa: E402
 from odpipe.pipeline.run import run_config  # noqa: E402
 from odpipe.products import residuals  # noqa: E402
-from odpipe.products.atomic import save_figure, write_csv, write_text  # noqa: E402
+from parsers.atomic import save_figure, write_csv, write_text  # noqa: E402
 from odpipe.time import utc_to_tdb  # noqa: E402
 
 HERE = Path(__file__).resolve().parent

@@ -25,7 +25,7 @@ import pandas as pd
 
 from odpipe.liaison import turan
 from odpipe.liaison.orbits import keplerian_orbit
-from odpipe.products.atomic import write_csv
+from parsers.atomic import write_csv
 
 HERE = Path(__file__).resolve().parent
 CFG = tomllib.loads((HERE / "liaison_turan.toml").read_text())

@@ -66,7 +66,7 @@ def night_report(out: Path, arcs: list[Path], outcomes, overlap_arcs: list[Path]
     from odpipe.analysis.overlap import consecutive_overlaps, oem_trajectory, report_tables
     from odpipe.pipeline.setup import tdb
     from odpipe.products import residuals
-    from odpipe.products.atomic import write_csv
+    from parsers.atomic import write_csv
     from odpipe.operations.report import Section, write_report
 
     out.mkdir(parents=True, exist_ok=True)

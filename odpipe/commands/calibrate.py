@@ -14,7 +14,7 @@ from pathlib import Path
 import numpy as np
 
 from odpipe.commands._inputs import add_geometry_arguments, catalog, read_table, select_spacecraft, with_geometry
-from odpipe.products.atomic import write_csv
+from parsers.atomic import write_csv
 
 NAME = "calibrate"
 HELP = "apply media calibrations (TRK-2-23 .TRO/.ION, IONEX) to a TrackingTable Parquet file"

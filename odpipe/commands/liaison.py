@@ -29,7 +29,7 @@ def add_arguments(p):
 def scenario(path: Path, out: Path, runs: int | None, parallel: bool) -> Path:
     """Run the scenario of configuration ``path`` into ``out``; returns its report."""
     from odpipe.liaison.config import load_config
-    from odpipe.products.atomic import write_text
+    from parsers.atomic import write_text
 
     cfg = load_config(path)
     if runs is not None:

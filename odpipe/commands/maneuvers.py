@@ -18,7 +18,7 @@ def run(args) -> int:
     import pandas as pd
 
     from odpipe.analysis.maneuvers import evaluate
-    from odpipe.products.atomic import write_text
+    from parsers.atomic import write_text
 
     tables = []
     for path in args.runs:

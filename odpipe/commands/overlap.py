@@ -27,7 +27,7 @@ def _labels(paths) -> list[str]:
 
 def run(args) -> int:
     from odpipe.analysis.overlap import compare, oem_trajectory, plot_overlaps, summarize
-    from odpipe.products.atomic import write_text
+    from parsers.atomic import write_text
 
     if len(args.oem) < 2:
         raise ValueError(f"odpipe overlap needs at least two OEM files, got {len(args.oem)}")

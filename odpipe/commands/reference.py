@@ -12,7 +12,7 @@ def add_arguments(parser) -> None:
 
 def run(args) -> int:
     from odpipe.pipeline.config import reference
-    from odpipe.products.atomic import write_text
+    from parsers.atomic import write_text
 
     text = reference()
     if args.output:

@@ -15,7 +15,7 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 
-from odpipe.products.atomic import save_figure
+from parsers.atomic import save_figure
 
 from .ground import NAMES, fit_schedule, prepare
 from .report import plot_convergence, write_markdown, write_table

@@ -10,7 +10,7 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 
-from odpipe.products.atomic import save_figure, write_csv, write_text
+from parsers.atomic import save_figure, write_csv, write_text
 
 
 def _cell(v) -> str:

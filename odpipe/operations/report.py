@@ -21,7 +21,7 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 
-from odpipe.products.atomic import write_text
+from parsers.atomic import write_text
 from odpipe.time import tdb_to_utc
 
 _STYLE = """

@@ -28,8 +28,7 @@ from datetime import datetime, timezone
 from importlib import metadata
 from pathlib import Path
 
-from odpipe.products.atomic import fsync_dir, write_text
-from parsers.atomic import pid_alive
+from parsers.atomic import fsync_dir, pid_alive, write_text
 
 MANIFEST = "manifest.json"
 OWNER = "attempt.json"

@@ -29,7 +29,7 @@ from odpipe.analysis import overlap
 from odpipe.constants import J2000, SECONDS_PER_DAY
 from odpipe.dynamics.compile_timer import compile_timer
 from odpipe.pipeline.run import run_config
-from odpipe.products.atomic import write_text
+from parsers.atomic import write_text
 from odpipe.products.spk import SpkTrajectory
 from odpipe.operations.nightly import night_summary, run_batch
 from odpipe.operations.report import Section, utc_iso, write_report

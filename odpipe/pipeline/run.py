@@ -33,7 +33,7 @@ from odpipe.pipeline.fitted_trajectory import fitted_segments
 from odpipe.preprocess.compress import compress
 from odpipe.preprocess.edit import EditConfig, edit
 from odpipe.products import parameters, residuals
-from odpipe.products.atomic import write_parquet, write_text
+from parsers.atomic import write_parquet, write_text
 from odpipe.products.oem import write_oem
 from odpipe.products.spk import write_spk
 from odpipe.operations import rundir

@@ -12,7 +12,7 @@ from datetime import datetime, timezone
 import numpy as np
 
 from odpipe.constants import J2000
-from odpipe.products.atomic import write_text
+from parsers.atomic import write_text
 from odpipe.products.segments import EphemerisSegment
 from odpipe.time import tdb_to_utc
 

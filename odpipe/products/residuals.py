@@ -12,7 +12,7 @@ from __future__ import annotations
 import numpy as np
 import pandas as pd
 
-from odpipe.products.atomic import save_figure
+from parsers.atomic import save_figure
 
 _RATE = ("doppler", "range_rate", "sst_doppler")
 

@@ -10,7 +10,7 @@ from __future__ import annotations
 import numpy as np
 import spiceypy as sp
 
-from odpipe.products.atomic import atomic_path
+from parsers.atomic import atomic_path
 from odpipe.products.segments import EphemerisSegment
 
 # NAIF ids of the centres a segment may name.

@@ -21,12 +21,12 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 
-from odpipe.products.atomic import write_bytes, write_parquet, write_text
-from odpipe.products.segments import EphemerisSegment
 from odpipe.products.oem import write_oem
+from odpipe.products.segments import EphemerisSegment
 from odpipe.products.spk import write_spk
 from odpipe.time import utc_to_doy
 from parsers import tdm, trk234, utdf
+from parsers.atomic import write_bytes, write_parquet, write_text
 from parsers.maneuvers import PLAN_COLUMNS, write_plan
 from parsers.table import TrackingData
 from parsers.tdm.message import Segment
