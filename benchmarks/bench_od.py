@@ -48,7 +48,9 @@ from odpipe.dynamics.propagator import propagate  # noqa: E402
 from odpipe.environment.gravity import read_gravity  # noqa: E402
 from odpipe.measurements import MeasurementSetup  # noqa: E402
 import odpipe.od.arc as arc_module  # noqa: E402
-from odpipe.od import ArcSetup, TrackingPlan, fit_arc, simulate_tracking  # noqa: E402
+from odpipe.od import ArcSetup, fit_arc  # noqa: E402
+from odpipe.simulate.observe import simulate_tracking  # noqa: E402
+from odpipe.simulate.schedule import TrackingPlan  # noqa: E402
 from odpipe.time import utc_to_tdb  # noqa: E402
 
 ROOT = Path(__file__).resolve().parents[1]

@@ -2,7 +2,7 @@
 
 ``simulate(tmp, start, end, extra_components=(), seed=7)`` integrates the truth from the peers'
 perigee state (shared/peers/bench/common.py), simulates 60-s two-way Doppler (0.1 mm/s) and range
-(1 m) with :mod:`odpipe.od.simulate`, writes ``tracking.parquet`` and returns (truth, x_start);
+(1 m) with :mod:`odpipe.simulate.observe`, writes ``tracking.parquet`` and returns (truth, x_start);
 ``write_config(tmp, name, start, end, state, estimation_extra="", naif_id=-900)`` writes ``arc.toml``
 for :func:`odpipe.pipeline.run.run_config`.
 """
@@ -15,7 +15,8 @@ from odpipe.dynamics.forces import ForceModel, PointMasses, SolarRadiationPressu
 from odpipe.dynamics.propagator import propagate
 from odpipe.environment.ephemeris import Ephemeris
 from odpipe.measurements import MeasurementSetup
-from odpipe.od.simulate import TrackingPlan, simulate_tracking
+from odpipe.simulate.observe import simulate_tracking
+from odpipe.simulate.schedule import TrackingPlan
 from odpipe.preprocess import store
 from odpipe.time import utc_to_tdb
 

@@ -1,7 +1,7 @@
 """The long-arc case of the OD tests and ``benchmarks/bench_od.py``: an ARTEMIS-P2-like Earth-Moon L1 arc.
 
 ``libration_arc(days)`` simulates the truth of ``runs/artemis_p2_like.toml`` with
-:mod:`odpipe.simulate` and its tracking with :func:`odpipe.od.simulate.simulate_tracking`.
+:mod:`odpipe.simulate` and its tracking with :func:`odpipe.simulate.observe.simulate_tracking`.
 """
 
 from __future__ import annotations
@@ -15,8 +15,9 @@ from odpipe.dynamics.forces import EmpiricalRTN, ImpulsiveManeuver
 from odpipe.estimation.registry import GaussMarkov
 from odpipe.measurements import MeasurementSetup
 from odpipe.od.arc import ArcSetup, ManeuverPlan
-from odpipe.od.simulate import TrackingPlan, simulate_tracking
 from odpipe.simulate.case import load
+from odpipe.simulate.observe import simulate_tracking
+from odpipe.simulate.schedule import TrackingPlan
 from odpipe.simulate.truth import simulate_truth
 from odpipe.time import utc_to_tdb
 
@@ -54,7 +55,7 @@ def libration_arc(days: float = 14.0, case_path=ARTEMIS_CASE) -> dict:
     st = case.stochastic
     setup = ArcSetup("SC", t0, t1, x0 + np.array([1e3, -1e3, 1e3, 1e-2, -1e-2, 1e-2]) / np.sqrt(3.0),
                      replace(truth.force_model, components=nominal), meas,
-                     stochastic=GaussMarkov(float(st["tau_s"]), float(st["sigma"]), float(st["batch_s"])),
+                     stochastic=GaussMarkov(st.tau_s, st.sigma, st.batch_s),
                      maneuvers=tuple(ManeuverPlan(m["name"], float(e), tuple(m["dv"]), 0.01, 10.0)
                                      for m, e in zip(truth.maneuvers, truth.epochs)),
                      lookback=300.0, data_sigma={"range": 2.0, "doppler_2way": 1e-4})

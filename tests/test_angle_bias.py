@@ -18,7 +18,7 @@ from odpipe.dynamics.propagator import propagate
 from odpipe.environment.ephemeris import Ephemeris
 from odpipe.measurements import MeasurementSetup, compute
 from odpipe.od.arc import ArcSetup, data_sigma, fit_arc
-from odpipe.od.simulate import TrackingPlan, visible_epochs
+from odpipe.simulate.schedule import TrackingPlan, visible_epochs
 from parsers.table import build
 from tests.heo_case import EPOCH0, R0, V0, tdb
 

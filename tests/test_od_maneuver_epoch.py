@@ -17,7 +17,9 @@ import pytest
 
 from odpipe.dynamics.forces import ImpulsiveManeuver
 from odpipe.dynamics.propagator import propagate
-from odpipe.od import ArcSetup, ManeuverPlan, TrackingPlan, TrackingProblem, fit_arc, simulate_tracking
+from odpipe.od import ArcSetup, ManeuverPlan, TrackingProblem, fit_arc
+from odpipe.simulate.observe import simulate_tracking
+from odpipe.simulate.schedule import TrackingPlan
 from odpipe.od.arc import build_registry, select_rows
 from odpipe.od.segment import SegmentTrajectory
 from odpipe.dynamics.forces import ForceModel

@@ -12,7 +12,8 @@ from dataclasses import replace
 
 import numpy as np
 
-from odpipe.od import ArcSetup, fit_arc, simulate_tracking
+from odpipe.od import ArcSetup, fit_arc
+from odpipe.simulate.observe import simulate_tracking
 from test_od_simulate import arc_state, force_model, measurement_setup, scenario
 
 F0 = 8.4e9

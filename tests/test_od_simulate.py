@@ -16,7 +16,8 @@ from odpipe.dynamics.forces import (EmpiricalRTN, ForceModel, ImpulsiveManeuver,
                                     SolarRadiationPressure)
 from odpipe.dynamics.propagator import propagate
 from odpipe.measurements import MeasurementSetup, compute
-from odpipe.od import TrackingPlan, simulate_tracking
+from odpipe.simulate.observe import simulate_tracking
+from odpipe.simulate.schedule import TrackingPlan
 from odpipe.time import utc_to_tdb
 from parsers.table import validate
 

@@ -3,12 +3,11 @@
 * :mod:`.segment` - reference trajectory of one segment (STM, sensitivities, look-back).
 * :mod:`.problem` - :class:`TrackingProblem`, the estimation ``Problem`` over table rows.
 * :mod:`.arc` - :func:`fit_arc` with :class:`ArcSetup` -> :class:`ArcSolution`.
-* :mod:`.simulate` - simulated DSN Doppler and range of a known trajectory.
+
+Simulated tracking of a known trajectory, to fit against the truth, is :mod:`odpipe.simulate`.
 """
 
 from .arc import ArcSetup, ArcSolution, ManeuverPlan, fit_arc
 from .problem import TrackingProblem
-from .simulate import TrackingPlan, simulate_tracking
 
-__all__ = ["ArcSetup", "ArcSolution", "ManeuverPlan", "TrackingPlan", "TrackingProblem", "fit_arc",
-           "simulate_tracking"]
+__all__ = ["ArcSetup", "ArcSolution", "ManeuverPlan", "TrackingProblem", "fit_arc"]

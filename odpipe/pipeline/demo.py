@@ -99,18 +99,18 @@ ion = ["../case/{Path(files['ion']).name}"]
 center = "earth"
 ephemeris = "de421"
 third_bodies = ["moon", "sun"]
-mass = {float(body['mass_kg'])}
+mass = {body.mass_kg}
 [dynamics.srp.cylinder]
-radius = {float(body['radius_m'])}
-length = {float(body['length_m'])}
-rho_s = {float(body['rho_s'])}
-rho_d = {float(body['rho_d'])}
-axis = {list(map(float, body['spin_axis']))}
+radius = {body.radius_m}
+length = {body.length_m}
+rho_s = {body.rho_s}
+rho_d = {body.rho_d}
+axis = {body.spin_axis}
 [initial_state]
 epoch = "{utc_iso(a)}"
 state = {list(map(float, x0))}
 [estimation]
-stochastic = {{ sigma = {float(case.stochastic['sigma'])}, tau = {float(case.stochastic['tau_s'])}, batch = {float(case.stochastic['batch_s'])} }}
+stochastic = {{ sigma = {case.stochastic.sigma}, tau = {case.stochastic.tau_s}, batch = {case.stochastic.batch_s} }}
 data_sigma = {{ {sig} }}
 maneuver_plan = "../case/{Path(files['maneuvers']).name}"
 [products]

@@ -1,95 +1,195 @@
-"""A simulated case description (TOML), e.g. ``runs/artemis_p2_like.toml``.
+"""A simulated case description (TOML), e.g. ``runs/artemis_p2_like.toml``: the schema, checked strictly.
 
-Schema (SI units unless the key says otherwise; times UTC ISO 8601)::
-
-    name, seed, start, days, spacecraft (DSN id, int), naif_id (int, negative)
-    [orbit]        point = 1|2 (Earth-Moon L1/L2), amplitude (CRTBP units, planar Lyapunov)
-    [spacecraft]   mass_kg, radius_m, length_m, rho_s, rho_d, spin_axis ([x,y,z] ICRF),
-                   spin_rpm, antenna_offset_m (0: no spin signature in the Doppler)
-    [stochastic]   sigma (m/s^2 per RTN axis), tau_s (Gauss-Markov time; 0 = white), batch_s
-    [station_keeping] first_days, every_days (epochs after the start), gap_days (list), horizon_days
-                   (designed at run time: perpendicular x-z crossing after gap, see odpipe.simulate.stationkeeping)
-    [[maneuver]]   name, epoch, kind (e.g. 'attitude'), dv ([x,y,z] ICRF m/s, designed)
-    [execution]    sigma_magnitude (fraction), sigma_pointing_deg (per maneuver)
-    [media]        sigma_wet_m, sigma_dry_m (per-day deviations from the DSN seasonal model),
-                   sigma_ion_m (S-band line-of-sight delay scale per DSN pass)
-    [[network]]    station, format ('trk234'|'utdf'), pad (UTDF pad id), band, uplink_hz,
-                   every_days, offset_days, passes (per tracking day), pass_s, mask_deg,
-                   doppler_count_s, sigma_doppler (m/s), range_step_s (0: no range),
-                   sigma_range (m), range_bias_sigma (m, per pass), ramp_rate_sigma (Hz/s; >0: ramped)
+SI units unless a key says otherwise; times are UTC ISO 8601. The sections are dataclasses that
+:mod:`odpipe.operations.schema` loads: an unknown key, a wrong type, a missing required key or a bad
+value is a :class:`~odpipe.operations.schema.ConfigError` naming the file, the key and its line.
+``odpipe reference`` documents every key (``docs/config.md``).
 """
 
 from __future__ import annotations
 
-import tomllib
 from dataclasses import dataclass, field, replace
 from pathlib import Path
+from typing import Literal
 
 import numpy as np
+
+from odpipe.constants import NS_PER_DAY
+from odpipe.operations.schema import (ConfigError, Problem, at_least, checked, finite, load as load_schema, positive,
+                                      read_toml)
+from odpipe.pipeline.config import utc_time
+
+
+def _vector(value: list) -> list[tuple[str, str]]:
+    return [] if len(value) == 3 else [("", f"expected 3 components [x, y, z], got {len(value)}")]
+
+
+@dataclass(frozen=True)
+class Orbit:
+    """A planar CRTBP Lyapunov orbit, put into the ephemeris' Earth-Moon geometry at the start."""
+
+    point: Literal[1, 2]  # Earth-Moon L1 or L2
+    amplitude: float = checked(positive)  # CRTBP length units (Earth-Moon distances)
+
+
+@dataclass(frozen=True)
+class SpacecraftModel:
+    """The spacecraft as the truth's force model and the Doppler's spin signature see it: a spinning cylinder."""
+
+    mass_kg: float = checked(positive)  # kg
+    radius_m: float = checked(positive)  # m, cylinder radius
+    length_m: float = checked(positive)  # m, cylinder length
+    rho_s: float = checked(at_least(0.0))  # specular reflectivity
+    rho_d: float = checked(at_least(0.0))  # diffuse reflectivity
+    spin_axis: list[float] = checked(_vector)  # ICRF direction [x, y, z], fixed
+    spin_rpm: float = checked(at_least(0.0), default=0.0)  # revolutions per minute
+    antenna_offset_m: float = checked(at_least(0.0), default=0.0)  # m off the spin axis; 0: no spin signature
+
+
+@dataclass(frozen=True)
+class Stochastic:
+    """Stochastic accelerations of the truth: piecewise-constant RTN batches, first-order Gauss-Markov."""
+
+    sigma: float = checked(at_least(0.0))  # m/s^2 per RTN axis
+    tau_s: float = checked(at_least(0.0))  # s, correlation time; 0: white
+    batch_s: float = checked(positive)  # s, batch length
+
+
+@dataclass(frozen=True)
+class StationKeeping:
+    """Station-keeping maneuvers, designed at run time for a perpendicular x-z plane crossing
+    (:mod:`odpipe.simulate.stationkeeping`)."""
+
+    first_days: float = checked(at_least(0.0))  # d after the start, first maneuver
+    every_days: float = checked(positive)  # d between maneuvers
+    gap_days: list[float] = checked(positive)  # d from a burn to its x-z crossing, tried in order
+    horizon_days: float = checked(positive)  # d, search window past each gap
+
+
+@dataclass(frozen=True)
+class Maneuver:
+    """A maneuver with a given delta-v ([[maneuver]], e.g. attitude burns)."""
+
+    name: str  # label in the maneuver files
+    epoch: str = checked(utc_time)  # UTC ISO time
+    kind: str  # e.g. "attitude"
+    dv: list[float] = checked(lambda v: _vector(v) + finite(v))  # designed delta-v, ICRF m/s
+
+
+@dataclass(frozen=True)
+class Execution:
+    """Execution errors of every maneuver, one draw each."""
+
+    sigma_magnitude: float = checked(at_least(0.0))  # fraction of the delta-v
+    sigma_pointing_deg: float = checked(at_least(0.0))  # deg, about a random axis normal to the delta-v
+
+
+@dataclass(frozen=True)
+class Media:
+    """Media errors: what the simulated TRK-2-23 calibrations deviate from the models by."""
+
+    sigma_wet_m: float = checked(at_least(0.0))  # m, per-day deviation of the zenith wet delay from the DSN seasonal model
+    sigma_dry_m: float = checked(at_least(0.0))  # m, per-day deviation of the zenith dry delay
+    sigma_ion_m: float = checked(at_least(0.0))  # m, S-band line-of-sight range delay scale per DSN pass (.ION cards)
 
 
 @dataclass(frozen=True)
 class Network:
-    station: str
-    format: str = "trk234"
-    pad: int = 0
-    band: str = "S"
-    uplink_hz: float = 2.0e9
-    every_days: float = 2.0
-    offset_days: float = 0.0
-    passes: int = 1
-    pass_s: float = 12600.0
-    mask_deg: float = 10.0
-    doppler_count_s: float = 60.0
-    sigma_doppler: float = 1e-4
-    range_step_s: float = 0.0
-    sigma_range: float = 2.0
-    range_bias_sigma: float = 0.0
-    ramp_rate_sigma: float = 0.0
+    """A tracking station's rule ([[network]]): on days offset_days + k every_days after the start, passes
+    inside the longest visibility above the mask (:mod:`odpipe.simulate.schedule`)."""
+
+    station: str  # station name in the catalog, e.g. "DSS-24"
+    format: Literal["trk234", "utdf"] = "trk234"  # the file its data are written to
+    pad: int = 0  # UTDF pad id
+    band: str = "S"  # up- and downlink band
+    uplink_hz: float = checked(positive, default=2.0e9)  # Hz, reference uplink
+    every_days: float = checked(positive, default=2.0)  # d between tracking days
+    offset_days: float = checked(at_least(0.0), default=0.0)  # d from the start to the first tracking day
+    passes: int = checked(at_least(1), default=1)  # passes per tracking day
+    pass_s: float = checked(positive, default=12600.0)  # s, pass length
+    mask_deg: float = 10.0  # deg, elevation mask
+    doppler_count_s: float = checked(positive, default=60.0)  # s, Doppler count time
+    sigma_doppler: float = checked(positive, default=1e-4)  # m/s, Doppler noise
+    range_step_s: float = checked(at_least(0.0), default=0.0)  # s between range points; 0: no range
+    sigma_range: float = checked(positive, default=2.0)  # m, range noise
+    range_bias_sigma: float = checked(at_least(0.0), default=0.0)  # m, range bias, one draw per pass
+    ramp_rate_sigma: float = checked(at_least(0.0), default=0.0)  # Hz/s, uplink ramp rate per pass; > 0: ramped
+
+
+@dataclass(frozen=True)
+class CaseFile:
+    """The top level of a case file."""
+
+    name: str  # case name: file stems of the simulated data
+    seed: int  # random seed: the same seed gives the same bytes
+    start: str = checked(utc_time)  # UTC ISO time
+    days: float = checked(positive)  # d, case length
+    spacecraft: int  # spacecraft id in the tracking files (DSN id)
+    naif_id: int  # NAIF id of the truth SPK (negative)
+    orbit: Orbit
+    spacecraft_model: SpacecraftModel
+    stochastic: Stochastic
+    execution: Execution
+    media: Media
+    station_keeping: StationKeeping
+    # tracking stations and their rules ([[network]], at least one)
+    network: list[Network] = checked(lambda v: [] if v else [("", "at least one [[network]] is required")])
+    # maneuvers with a given delta-v, besides the station keeping
+    maneuver: list[Maneuver] = field(default_factory=list)
 
 
 @dataclass(frozen=True)
 class Case:
+    """A loaded case: the file's sections, times as UTC datetime64[ns], maneuvers in time order as dicts
+    (name, epoch, kind, dv: ICRF m/s array)."""
+
     name: str
     seed: int
     start: np.datetime64
     days: float
     spacecraft: int
     naif_id: int
-    orbit: dict
-    body: dict
-    stochastic: dict
+    orbit: Orbit
+    body: SpacecraftModel
+    stochastic: Stochastic
     maneuvers: list
-    execution: dict
-    media: dict
-    station_keeping: dict
+    execution: Execution
+    media: Media
+    station_keeping: StationKeeping
     networks: tuple = field(default_factory=tuple)
 
     @property
     def end(self) -> np.datetime64:
-        return self.start + np.timedelta64(int(self.days * 86400e9), "ns")
+        return self.start + np.timedelta64(int(self.days * NS_PER_DAY), "ns")
 
     def station_keeping_epochs(self) -> np.ndarray:
         """UTC epochs of the station-keeping maneuvers inside the case span."""
         sk = self.station_keeping
-        days = np.arange(float(sk["first_days"]), self.days, float(sk["every_days"]))
-        return self.start + (days * 86400e9).astype("timedelta64[ns]")
+        days = np.arange(sk.first_days, self.days, sk.every_days)
+        return self.start + (days * NS_PER_DAY).astype("timedelta64[ns]")
 
     def shortened(self, days: float) -> "Case":
         """The same case over its first ``days`` (maneuvers after the end dropped)."""
-        end = self.start + np.timedelta64(int(days * 86400e9), "ns")
+        end = self.start + np.timedelta64(int(days * NS_PER_DAY), "ns")
         return replace(self, days=days, maneuvers=[m for m in self.maneuvers if m["epoch"] < end])
 
 
+def _utc(value: str) -> np.datetime64:
+    return np.datetime64(value.replace("Z", "").replace("+00:00", ""), "ns")
+
+
 def load(path) -> Case:
-    """Read a case file (schema in the module docstring)."""
-    d = tomllib.loads(Path(path).read_text())
-
-    def utc(v):
-        return np.datetime64(str(v).replace("Z", "").replace("+00:00", ""), "ns")
-
-    mans = [dict(m, epoch=utc(m["epoch"]), dv=np.asarray(m["dv"], float)) for m in d.get("maneuver", [])]
-    return Case(d["name"], int(d["seed"]), utc(d["start"]), float(d["days"]), int(d["spacecraft"]),
-                int(d["naif_id"]), d["orbit"], d["spacecraft_model"], d["stochastic"],
-                sorted(mans, key=lambda m: m["epoch"]), d["execution"], d["media"],
-                d["station_keeping"], tuple(Network(**n) for n in d["network"]))
+    """Read and check a case file: one ConfigError names the file and every wrong key with its line."""
+    path = Path(path)
+    data, text = read_toml(path)
+    f = load_schema(CaseFile, data, path, text=text)
+    names = [n.station for n in f.network]
+    twice = sorted({n for n in names if names.count(n) > 1})
+    if twice:
+        raise ConfigError(path, problems=[Problem("network", f"station {n!r} has two rules")
+                                          for n in twice]).located(text)
+    mans = [{"name": m.name, "epoch": _utc(m.epoch), "kind": m.kind, "dv": np.asarray(m.dv, float)}
+            for m in f.maneuver]
+    return Case(f.name, f.seed, _utc(f.start), f.days, f.spacecraft, f.naif_id, f.orbit, f.spacecraft_model,
+                f.stochastic, sorted(mans, key=lambda m: m["epoch"]), f.execution, f.media, f.station_keeping,
+                tuple(f.network))

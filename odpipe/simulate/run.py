@@ -32,9 +32,9 @@ def run_case(case_path, out, days: float | None = None, stations_csv: Path = STA
     setup = MeasurementSetup(eph, catalog, gcrs_to_itrs=gcrs_to_itrs)
     truth = simulate_truth(case, eph, rng)
     table, ramps = plan_rows(case, truth.trajectory, setup, rng)
-    tro = tro_text([n.station for n in case.networks], case.start, case.end, float(case.media["sigma_wet_m"]),
-                   float(case.media["sigma_dry_m"]), rng)
-    ion = ion_text(dsn_passes(table), case.spacecraft, float(case.media["sigma_ion_m"]), rng)
+    tro = tro_text([n.station for n in case.networks], case.start, case.end, case.media.sigma_wet_m,
+                   case.media.sigma_dry_m, rng)
+    ion = ion_text(dsn_passes(table), case.spacecraft, case.media.sigma_ion_m, rng)
     model = MediaModel(CalibrationSet(parse_text(tro, f"{case.name}.TRO") + parse_text(ion, f"{case.name}.ION")))
     obs = observe(case, table, ramps, truth.trajectory, setup, model, catalog, rng)
     paths = write_case(Path(out), case, truth, obs, {"tro": tro, "ion": ion}, setup, stations_csv)

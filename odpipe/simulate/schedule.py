@@ -1,6 +1,7 @@
 """Tracking passes and sample epochs from visibility and cadence rules.
 
-A network rule (:class:`odpipe.simulate.case.Network`) tracks on days
+A :class:`TrackingPlan` tracks from each of its stations whenever the spacecraft is above the
+mask (:func:`visible_epochs`). A network rule (:class:`odpipe.simulate.case.Network`) tracks on days
 ``offset_days + k * every_days`` after the case start. On a tracking day the
 longest run of the spacecraft above the elevation mask (60-s grid, elevation
 from the measurement models) holds the passes: one pass centred on the
@@ -10,6 +11,8 @@ range samples every ``range_step_s`` at reception.
 """
 
 from __future__ import annotations
+
+from dataclasses import dataclass
 
 import numpy as np
 
@@ -33,6 +36,39 @@ def elevation(traj, setup, station: str, spacecraft: str, epochs: np.ndarray) ->
     rows = build(epochs.size, epoch=epochs, observable="angle_el", unit="rad", station_rx=station,
                  station_tx=station, spacecraft=spacecraft, tag="receive", count_time=0.0)
     return compute(rows, {spacecraft: StateOnly(traj)}, setup).value
+
+
+@dataclass(frozen=True)
+class TrackingPlan:
+    """What to simulate: stations, span (UTC datetime64), cadences (s), mask (rad), noise (LOS units);
+    doppler: 'doppler_2way' or 'doppler_1way' (reference frequency ``uplink_hz``)."""
+
+    stations: tuple
+    start: np.datetime64
+    end: np.datetime64
+    doppler_step: float = 60.0
+    range_step: float = 600.0
+    min_elevation: float = np.radians(10.0)
+    sigma_doppler: float = 1e-4          # m/s
+    sigma_range: float = 1.0             # m
+    range_bias_sigma: float = 0.0        # m, one draw per pass
+    uplink_hz: float = 7.16e9
+    band: str = "X"
+    spacecraft: str = "SC"
+    doppler: str = "doppler_2way"
+
+
+def visible_epochs(traj, plan: TrackingPlan, setup) -> dict:
+    """Per station: candidate epochs (UTC, every ``doppler_step``) and their pass ids (-1: below the mask)."""
+    step = np.timedelta64(int(plan.doppler_step * NS_PER_S), "ns")
+    epochs = np.arange(np.datetime64(plan.start, "ns"), np.datetime64(plan.end, "ns") + step, step)
+    out, next_pass = {}, 0
+    for st in plan.stations:
+        up = elevation(traj, setup, st, plan.spacecraft, epochs) > plan.min_elevation
+        run = np.cumsum(np.diff(np.concatenate([[False], up])) == 1)
+        out[st] = (epochs, np.where(up, run - 1 + next_pass, -1))
+        next_pass += int(run[-1]) if run.size else 0
+    return out
 
 
 def passes(traj, setup, net, spacecraft: str, start: np.datetime64, end: np.datetime64) -> list[tuple]:

@@ -19,6 +19,7 @@ from dataclasses import dataclass, replace
 
 import numpy as np
 
+from odpipe.constants import SECONDS_PER_DAY
 from odpipe.dynamics import (Cylinder, EmpiricalRTN, ForceModel, ImpulsiveManeuver, PointMasses,
                              SolarRadiationPressure, propagate)
 from odpipe.dynamics.trajectory import Trajectory
@@ -67,7 +68,7 @@ def gauss_markov_batches(t0: float, t1: float, batch_s: float, sigma: float, tau
 def initial_state(case, ephemeris, t0: float) -> np.ndarray:
     """Geocentric ICRF state (m, m/s) at t0 from the case's CRTBP Lyapunov orbit."""
     mu = ephemeris.gm("moon") / (ephemeris.gm("moon") + ephemeris.gm("earth"))
-    s, _ = lyapunov_orbit(mu, int(case.orbit["point"]), float(case.orbit["amplitude"]))
+    s, _ = lyapunov_orbit(mu, case.orbit.point, case.orbit.amplitude)
     return rotating_to_icrf(s, mu, ephemeris.state("moon", "earth", np.array([t0]))[0])
 
 
@@ -76,15 +77,15 @@ def simulate_truth(case, ephemeris, rng) -> Truth:
     t0 = float(utc_to_tdb(case.start)) - MARGIN_S
     t1 = float(utc_to_tdb(case.end)) + MARGIN_S
     sc, st, ex, sk = case.body, case.stochastic, case.execution, case.station_keeping
-    batches = gauss_markov_batches(t0, t1, float(st["batch_s"]), float(st["sigma"]), float(st["tau_s"]), rng)
-    axis = np.asarray(sc["spin_axis"], float)
+    batches = gauss_markov_batches(t0, t1, st.batch_s, st.sigma, st.tau_s, rng)
+    axis = np.asarray(sc.spin_axis, float)
     nominal = ForceModel("earth", [
         PointMasses(["moon", "sun"]),
-        SolarRadiationPressure(surfaces=[Cylinder(axis / np.linalg.norm(axis), float(sc["radius_m"]),
-                                                  float(sc["length_m"]), float(sc["rho_s"]), float(sc["rho_d"]))]),
-    ], mass=float(sc["mass_kg"]), ephemeris=ephemeris)
-    gaps = tuple(np.atleast_1d(np.asarray(sk["gap_days"], float)) * 86400.0)
-    horizon = float(sk["horizon_days"]) * 86400.0
+        SolarRadiationPressure(surfaces=[Cylinder(axis / np.linalg.norm(axis), sc.radius_m, sc.length_m, sc.rho_s,
+                                                  sc.rho_d)]),
+    ], mass=sc.mass_kg, ephemeris=ephemeris)
+    gaps = tuple(np.asarray(sk.gap_days, float) * SECONDS_PER_DAY)
+    horizon = sk.horizon_days * SECONDS_PER_DAY
     x0 = initial_state(case, ephemeris, t0)
     x0[3:] += design_dv(nominal, x0, t0, gaps, horizon)
     events = sorted([dict(m) for m in case.maneuvers]
@@ -98,8 +99,7 @@ def simulate_truth(case, ephemeris, rng) -> Truth:
         if m["dv"] is None:
             state = propagate(x0, t0, t, fm, with_stm=False).state(t)[0]
             m["dv"] = design_dv(nominal, state, t, gaps, horizon)
-        executed.append((t, executed_dv(m["dv"], float(ex["sigma_magnitude"]),
-                                        np.radians(float(ex["sigma_pointing_deg"])), rng)[0]))
+        executed.append((t, executed_dv(m["dv"], ex.sigma_magnitude, np.radians(ex.sigma_pointing_deg), rng)[0]))
     fm = replace(nominal, components=components + [ImpulsiveManeuver(e, dv) for e, dv in executed])
     traj = propagate(x0, t0, t1, fm, with_stm=False)
     return Truth(traj, fm, events, np.array([m["dv"] for m in events]).reshape(-1, 3),
