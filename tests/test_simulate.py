@@ -292,3 +292,22 @@ def test_dsn_doppler_counts_carry_their_media_through_compression(sim):
     # geometry here is the pipeline's (no aberration, two light-time iterations), at simulation the
     # measurement models': the elevations differ by up to 9e-5 rad, the changes by up to 0.1 % at low elevation
     np.testing.assert_allclose(got["media_m"].to_numpy()[i][known], media[known], rtol=2e-3, atol=1e-6)
+
+
+def test_case_file_problems_name_each_key_and_line(tmp_path):
+    """The case loader is the strict schema loader: a wrong type, a bad value and a station with two
+    rules are one ConfigError naming each key and its line in the file."""
+    from odpipe.operations.schema import ConfigError
+    from odpipe.simulate.case import load
+
+    text = CASE.read_text()
+    lines = text.splitlines()
+    bad = text.replace("amplitude = 0.01 ", 'amplitude = "0.01"').replace('station = "DSS-34"', 'station = "DSS-24"')
+    bad = bad.replace("mass_kg = 90.0", "mass_kg = -90.0")
+    (tmp_path / "bad.toml").write_text(bad)
+    with pytest.raises(ConfigError) as err:
+        load(tmp_path / "bad.toml")
+    got = {(p.key, p.line) for p in err.value.problems}
+    assert got == {("orbit.amplitude", lines.index(next(ln for ln in lines if ln.startswith("amplitude"))) + 1),
+                   ("spacecraft_model.mass_kg", lines.index("mass_kg = 90.0") + 1),
+                   ("network[1].station", lines.index('station = "DSS-34"') + 1)}

@@ -1,20 +1,31 @@
-"""``odpipe reference``: the run configuration reference (every key, type, default, meaning) as Markdown."""
+"""``odpipe reference``: the configuration reference (every key, type, default, meaning) as Markdown.
+
+One document for every kind of configuration file: run configurations, then simulated cases.
+``docs/config.md`` is its output.
+"""
 
 from __future__ import annotations
 
 NAME = "reference"
-HELP = "print the run configuration reference (every key, type, unit, default) as Markdown"
+HELP = "print the configuration reference (run configurations, simulated cases: every key, type, unit, default)"
 
 
 def add_arguments(parser) -> None:
     parser.add_argument("-o", "--output", help="write to this file instead of standard output")
 
 
+def document() -> str:
+    """The reference of every configuration kind, one Markdown document."""
+    from odpipe.pipeline.config import reference as run_reference
+    from odpipe.simulate.case import reference as case_reference
+
+    return run_reference() + "\n" + case_reference()
+
+
 def run(args) -> int:
-    from odpipe.pipeline.config import reference
     from parsers.atomic import write_text
 
-    text = reference()
+    text = document()
     if args.output:
         write_text(args.output, text)
     else:

@@ -15,13 +15,20 @@ from typing import Literal
 import numpy as np
 
 from odpipe.constants import NS_PER_DAY
-from odpipe.operations.schema import (ConfigError, Problem, at_least, checked, finite, load as load_schema, positive,
-                                      read_toml)
+from odpipe.operations.schema import at_least, checked, finite, load as load_schema, positive, read_toml
 from odpipe.pipeline.config import utc_time
 
 
 def _vector(value: list) -> list[tuple[str, str]]:
     return [] if len(value) == 3 else [("", f"expected 3 components [x, y, z], got {len(value)}")]
+
+
+def _networks(value: list) -> list[tuple[str, str]]:
+    """At least one network, one rule per station."""
+    if not value:
+        return [("", "at least one [[network]] is required")]
+    names = [n.station for n in value]
+    return [(f"[{i}].station", f"{name!r} has a rule already") for i, name in enumerate(names) if name in names[:i]]
 
 
 @dataclass(frozen=True)
@@ -58,7 +65,7 @@ class Stochastic:
 @dataclass(frozen=True)
 class StationKeeping:
     """Station-keeping maneuvers, designed at run time for a perpendicular x-z plane crossing
-    (:mod:`odpipe.simulate.stationkeeping`)."""
+    (odpipe.simulate.stationkeeping)."""
 
     first_days: float = checked(at_least(0.0))  # d after the start, first maneuver
     every_days: float = checked(positive)  # d between maneuvers
@@ -96,7 +103,7 @@ class Media:
 @dataclass(frozen=True)
 class Network:
     """A tracking station's rule ([[network]]): on days offset_days + k every_days after the start, passes
-    inside the longest visibility above the mask (:mod:`odpipe.simulate.schedule`)."""
+    inside the longest visibility above the mask (odpipe.simulate.schedule)."""
 
     station: str  # station name in the catalog, e.g. "DSS-24"
     format: Literal["trk234", "utdf"] = "trk234"  # the file its data are written to
@@ -133,7 +140,7 @@ class CaseFile:
     media: Media
     station_keeping: StationKeeping
     # tracking stations and their rules ([[network]], at least one)
-    network: list[Network] = checked(lambda v: [] if v else [("", "at least one [[network]] is required")])
+    network: list[Network] = checked(_networks)
     # maneuvers with a given delta-v, besides the station keeping
     maneuver: list[Maneuver] = field(default_factory=list)
 
@@ -183,13 +190,15 @@ def load(path) -> Case:
     path = Path(path)
     data, text = read_toml(path)
     f = load_schema(CaseFile, data, path, text=text)
-    names = [n.station for n in f.network]
-    twice = sorted({n for n in names if names.count(n) > 1})
-    if twice:
-        raise ConfigError(path, problems=[Problem("network", f"station {n!r} has two rules")
-                                          for n in twice]).located(text)
     mans = [{"name": m.name, "epoch": _utc(m.epoch), "kind": m.kind, "dv": np.asarray(m.dv, float)}
             for m in f.maneuver]
     return Case(f.name, f.seed, _utc(f.start), f.days, f.spacecraft, f.naif_id, f.orbit, f.spacecraft_model,
                 f.stochastic, sorted(mans, key=lambda m: m["epoch"]), f.execution, f.media, f.station_keeping,
                 tuple(f.network))
+
+
+def reference() -> str:
+    """The case file reference (Markdown), generated from the classes above."""
+    from odpipe.operations.reference import markdown
+
+    return markdown(CaseFile, "Simulated case reference (`odpipe simulate CASE`)")
