@@ -95,7 +95,7 @@ class Execution:
 class Media:
     """Media errors: what the simulated TRK-2-23 calibrations deviate from the models by."""
 
-    sigma_wet_m: float = checked(at_least(0.0))  # m, per-day deviation of the zenith wet delay from the DSN seasonal model
+    sigma_wet_m: float = checked(at_least(0.0))  # m, per-day deviation of the zenith wet delay from the DSN model
     sigma_dry_m: float = checked(at_least(0.0))  # m, per-day deviation of the zenith dry delay
     sigma_ion_m: float = checked(at_least(0.0))  # m, S-band line-of-sight range delay scale per DSN pass (.ION cards)
 
