@@ -1,4 +1,4 @@
-"""Readers and writers of tracking and calibration formats (numpy/pandas only).
+"""Readers and writers of tracking and calibration formats (numpy/pandas, and odpipe.constants only).
 
 Every tracking reader module exposes ``sniff(head: bytes) -> bool`` (does this
 file look like my format?) and ``read(path, errors="raise") -> TrackingData``

@@ -2,8 +2,8 @@
 
 The one home of atomic writing for the whole project (the format writers of
 ``parsers`` and every product, table, plot and report of ``odpipe``); it lives
-here because ``parsers`` may not import ``odpipe``, while ``odpipe`` imports
-``parsers``.
+here because ``parsers`` imports no ``odpipe`` module (but ``odpipe.constants``),
+while ``odpipe`` imports ``parsers``.
 
 A write goes to a temporary file in the destination folder
 (``.NAME.HOST-PID.RANDOM.part``), which is flushed and fsynced, renamed over the
