@@ -95,7 +95,7 @@ def run_config(path, *, force: bool = False, progress=print) -> dict:
 
 
 def _run(cfg: RunConfig, attempt, log: RunLog, fingerprint: dict) -> dict:
-    data = ingest(cfg.data.files, cfg.data.errors)
+    data = ingest(cfg.data.files, cfg.data.errors, cfg.arc.spacecraft)
     for line in data.log:
         log(line)
     table = data.table[data.table["spacecraft"].astype(str) == cfg.arc.spacecraft].reset_index(drop=True)
