@@ -21,13 +21,15 @@ from odpipe.dynamics.propagator import propagate
 
 def windows(start: float, end: float, epoch: float, half: float, factor: float) -> list[tuple[float, float]]:
     """The windows (TDB s) fitted before the whole arc ``[start, end]``: ``epoch ± half``, widened
-    ``factor`` times each step, clipped to the arc; the whole arc itself is not in the list."""
+    ``factor`` times each step, clipped to the arc (those outside it left out); the whole arc itself is
+    not in the list."""
     out = []
     while True:
         a, b = max(start, epoch - half), min(end, epoch + half)
         if a <= start and b >= end:
             return out
-        out.append((a, b))
+        if a < b:
+            out.append((a, b))
         half *= factor
 
 
