@@ -134,6 +134,8 @@ W3B_ANGLE_BIASES_DEG = {  # Orekit's testW3B: (azimuth, elevation) bias per stat
     "CastleRock": (0.062701342, -0.003613508), "Fucino": (-0.053526137, 0.075483886),
     "Kumsan": (-0.023574208, -0.054520756), "Pretoria": (0.030201539, 0.009747877),
     "Uralla": (0.167814449, -0.12305252)}
+W3B_RANGE_BIASES_M = {"CastleRock": 11274.4677, "Fucino": 13467.8256, "Kumsan": 13512.57594, "Pretoria": 13594.11889,
+                      "Uralla": 13450.26738}                     # Orekit's testW3B, m (beside its 5969 m onboard)
 
 
 @pytest.mark.realdata
@@ -156,6 +158,10 @@ def test_w3b_run_without_the_leak_matches_orekits_angles(tmp_path, shared_data):
             b = p.loc[f"bias.{obs}.{station}"]
             assert b["unit"] == "rad"
             assert ((b["estimate"] - np.radians(orekit)) / b["sigma"]) ** 2 < chi2.ppf(0.999, 1)
+    # the leak, not modelled, moves the range biases by up to 600 m; the 5969 m onboard bias with the wrong sign
+    # would move each by 11.9 km
+    for station, orekit in W3B_RANGE_BIASES_M.items():
+        assert abs(p.loc[f"bias.range.{station}.pass-1", "estimate"] - orekit) < 1000.0
     cd = p.loc["W3B.cd"]
     assert cd["apriori"] == 2.0 and abs(cd["estimate"] - (-0.2154)) < np.sqrt(0.687998)   # Orekit's sigma
     x, _ = _state_and_cov(products, "2010-11-02T02:56:15.690")
