@@ -11,12 +11,16 @@ arc's, with the arc's own editing; the earlier ones edit nothing.
 
 from __future__ import annotations
 
+import logging
 from dataclasses import replace
 
 import numpy as np
 import pandas as pd
 
 from odpipe.dynamics.propagator import propagate
+from odpipe.time import tdb_to_utc
+
+_log = logging.getLogger(__name__)
 
 
 def windows(start: float, end: float, epoch: float, half: float, factor: float) -> list[tuple[float, float]]:
@@ -54,9 +58,12 @@ def fit_outward(table: pd.DataFrame, setup):
         n = len(select_rows(table, sub)[0])
         if n == 0 or n == used:  # nothing new to fit in this window
             continue
+        utc = (tdb_to_utc(np.array([a, b])) + np.timedelta64(500, "ms")).astype("datetime64[s]")
+        _log.info("outward fit: %d rows of %s .. %s UTC", n, *utc)
         sol = fit_arc(table, sub)
         history += [{**h, "window": (a, b)} for h in sol.history]
         t_state, state, used = sol.epochs[0], sol.states[0], n
+    _log.info("outward fit: the whole arc")
     sol = fit_arc(table, replace(base, state0=_state_at(state, t_state, setup.start, setup.force_model)))
     sol.history = history + [{**h, "window": (setup.start, setup.end)} for h in sol.history]
     return sol
