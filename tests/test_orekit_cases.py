@@ -86,6 +86,10 @@ def test_outward_windows_widen_about_the_epoch_until_the_arc_is_covered():
     ("SLRF2014_POS+VEL_2030.0_200428.snx", "lageos2_20160214.npt", "data.sinex.file", "is not a SINEX file"),
     ('frame = "EME2000"', 'frame = "J2000"', "initial_state.frame", "expected one of"),
     ("com_offset = 0.251", "com_offset = nan", "measurements.com_offset", "must be finite"),
+    ("srp_scale_sigma = 1.0", 'srp_scale_sigma = 1.0\nangle_bias_apriori = { angle_az = "1 deg" }',
+     "estimation.angle_bias_apriori", "needs estimation.angle_bias_sigma"),
+    ("srp_scale_sigma = 1.0", 'srp_scale_sigma = 1.0\nangle_bias_sigma = "1 deg"\nangle_bias_apriori = { range = 1.0 }',
+     "estimation.angle_bias_apriori.range", "not an angle observable"),
 ])
 def test_bad_orekit_keys_name_the_key_and_line(tmp_path, shared_data, old, new, key, reason):
     path = _local_config(tmp_path, shared_data, "lageos2_2016_02_14.toml")

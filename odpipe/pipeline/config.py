@@ -340,6 +340,9 @@ class EstimationSection:
     outward: OutwardSection | None = None  # fit outward from the a priori epoch (none: the whole arc at once)
 
     def problems(self):
+        for key in self.angle_bias_apriori:
+            if key.split(":")[0] not in ("angle_az", "angle_el", "angle_x", "angle_y"):
+                yield f"angle_bias_apriori.{key}", "not an angle observable (angle_az, angle_el, angle_x, angle_y)"
         if not self.sigma_scale:
             yield "sigma_scale", "needs at least one stage"
         if not self.edit_k:
@@ -377,8 +380,6 @@ class RunConfig:
             yield "estimation.cd_sigma", "needs [dynamics.drag] (no drag to estimate a Cd of)"
         if est.outward is not None and self.initial_state.epoch is None:
             yield "estimation.outward", "needs initial_state.epoch (the fit grows outward from it)"
-        if est.range_bias_apriori and est.range_bias_sigma is None:
-            yield "estimation.range_bias_apriori", "needs estimation.range_bias_sigma (biases are not estimated)"
         if est.angle_bias_apriori and est.angle_bias_sigma is None:
             yield "estimation.angle_bias_apriori", "needs estimation.angle_bias_sigma (biases are not estimated)"
 
