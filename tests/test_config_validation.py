@@ -77,7 +77,7 @@ def test_the_good_configuration_loads(tmp_path):
     ('name = "arc"', 'name = "../../x"', "run.name", "'../../x' is not a plain name"),
     ("state = [7.0e6, 0.0, 0.0, 0.0, 7.5e3, 0.0]", "state = [7.0e6, 0.0, 0.0, 0.0, 7.5e3, inf]",
      "initial_state.state", "needs 6 finite numbers (m, m/s)"),
-    ('center = "earth"', 'center = "earth"\nmas = 5.0', "dynamics.mas", "unknown key (allowed: center, ephemeris"),
+    ('center = "earth"', 'center = "earth"\nmas = 5.0', "dynamics.mas", "unknown key (allowed: center, drag, ephemeris"),
 ])
 def test_one_bad_value_names_its_key_and_line(tmp_path, capsys, old, new, key, reason):
     text = GOOD.replace(old, new)

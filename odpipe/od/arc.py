@@ -21,7 +21,7 @@ import numpy as np
 import pandas as pd
 
 from odpipe.constants import SECONDS_PER_DAY
-from odpipe.dynamics.forces import ForceModel, SolarRadiationPressure
+from odpipe.dynamics.forces import AtmosphericDrag, ForceModel, SolarRadiationPressure
 from odpipe.estimation.fit import EDIT_INNOVATION, NONFINITE, FitOptions, Observations, Solution, build_grid, fit
 from odpipe.estimation.maneuvers import maneuver_table
 from odpipe.estimation.registry import GaussMarkov, ParameterRegistry
@@ -61,7 +61,11 @@ class ArcSetup:
     for angle rows (unit rad) the angle's own sigma: a number in rad or a string with its unit, "0.01 deg",
     "36 arcsec", "1.7e-4 rad" (:data:`ANGLE_UNITS`).
     angle_bias_sigma: one constant bias (rad) per receiving station and angle observable (None: none).
-    range_bias_sigma: per pass and receiving station (m; None: no biases; pass_id -1 = one per station).
+    range_bias_sigma: per pass and receiving station (m; None: no biases; pass_id -1 = one per station);
+    ``range_bias_per`` "station": one per station over the arc whatever the passes.
+    bias_apriori: a priori bias values (m; rad for angles) by "observable:station_rx" or "observable" (others 0).
+    cd_sigma: a priori sigma of the drag coefficient (None: not estimated; a priori the model's Cd).
+    outward: (epoch TDB s, first half-window s, factor): fit outward from that epoch (:mod:`.outward`).
     oscillator_sigma: (y0, y1 1/s) sigmas of the one-way oscillator's fractional frequency offset and drift,
     when doppler_1way is fitted (a priori and reference epoch from ``measurements.oscillators``).
     station_sigma: considered (not estimated) error of each station's ITRS coordinates (m per axis).
@@ -86,7 +90,10 @@ class ArcSetup:
     maneuvers: tuple = ()
     data_sigma: dict = field(default_factory=lambda: dict(DATA_SIGMA))
     range_bias_sigma: float | None = 5.0
+    range_bias_per: str = "pass"
     angle_bias_sigma: float | None = None
+    bias_apriori: dict = field(default_factory=dict)
+    cd_sigma: float | None = None
     oscillator_sigma: tuple | None = None
     station_sigma: float | None = None
     media_sigma: float | None = None
@@ -98,6 +105,7 @@ class ArcSetup:
     lookback: float = 120.0
     growing_days: float | None = 2.0  # first span of the growing-arc start (None: fit the whole arc at once)
     tabulate_earth_rotation: bool = True
+    outward: tuple | None = None
 
 
 @dataclass
@@ -185,23 +193,31 @@ def build_registry(setup: ArcSetup, rows: pd.DataFrame) -> ParameterRegistry:
         if not srp:
             raise ValueError("srp_scale_sigma given but the force model has no SRP")
         reg.add(f"{sc}.srp_scale", "dynamic", srp[0].scale, setup.srp_scale_sigma, owner=sc, model="srp_scale")
+    if setup.cd_sigma is not None:
+        drag = setup.force_model.of_type(AtmosphericDrag)
+        if not drag:
+            raise ValueError("cd_sigma given but the force model has no drag")
+        reg.add(f"{sc}.cd", "dynamic", drag[0].cd, setup.cd_sigma, owner=sc, model="cd")
     if setup.stochastic is not None:
         g = setup.stochastic
         reg.add_stochastic_acceleration(sc, g.sigma, g.tau, g.batch)
     for m in setup.maneuvers:
         reg.add_maneuver(sc, m.label, m.epoch, m.sigma, m.designed, sigma_epoch=m.sigma_epoch)
     if setup.range_bias_sigma is not None:
-        rng = rows[rows["observable"] == "range"]
-        for st, pid in rng[["station_rx", "pass_id"]].drop_duplicates().itertuples(index=False):
+        rng = rows.loc[rows["observable"] == "range", ["station_rx", "pass_id"]]
+        if setup.range_bias_per == "station":
+            rng = rng.assign(pass_id=-1)
+        for st, pid in rng.drop_duplicates().itertuples(index=False):
             info = {"observable": "range", "station": st, "spacecraft": sc}
             if pid >= 0:
                 info["pass_id"] = pid
-            reg.add(f"bias.range.{st}.pass{pid}", "bias", 0.0, setup.range_bias_sigma, owner=st, **info)
+            reg.add(f"bias.range.{st}.pass{pid}", "bias", _bias_apriori(setup, "range", st), setup.range_bias_sigma,
+                    owner=st, **info)
     if setup.angle_bias_sigma is not None:
         ang = rows[rows["unit"] == "rad"]
         for obs, st in ang[["observable", "station_rx"]].drop_duplicates().itertuples(index=False):
-            reg.add(f"bias.{obs}.{st}", "bias", 0.0, setup.angle_bias_sigma, owner=st, observable=obs, station=st,
-                    spacecraft=sc)
+            reg.add(f"bias.{obs}.{st}", "bias", _bias_apriori(setup, obs, st), setup.angle_bias_sigma, owner=st,
+                    observable=obs, station=st, spacecraft=sc)
     if setup.oscillator_sigma is not None and (rows["observable"] == "doppler_1way").any():
         y0, y1, _ = setup.measurements.oscillators[sc]
         reg.add(f"{sc}.osc_y0", "clock", y0, setup.oscillator_sigma[0], owner=sc, oscillator="y0")
@@ -217,6 +233,11 @@ def build_registry(setup: ArcSetup, rows: pd.DataFrame) -> ParameterRegistry:
     return reg
 
 
+def _bias_apriori(setup: ArcSetup, observable: str, station) -> float:
+    a = setup.bias_apriori
+    return float(a.get(f"{observable}:{station}", a.get(observable, 0.0)))
+
+
 def fit_arc(table: pd.DataFrame, setup: ArcSetup) -> ArcSolution:
     """Fit the arc; see :class:`ArcSetup` and :class:`ArcSolution`.
 
@@ -226,6 +247,10 @@ def fit_arc(table: pd.DataFrame, setup: ArcSetup) -> ArcSolution:
     last iteration), to_los (m or m/s per unit), apriori_los/prefit_los/postfit_los, sigma (row units, after reweighting), flags (Flag.RESIDUAL when
     edited by the fit), status (why a row could not be computed; such rows are not fitted).
     """
+    if setup.outward is not None:
+        from .outward import fit_outward  # it fits windows of this arc through this function
+
+        return fit_outward(table, setup)
     rows, times = select_rows(table, setup)
     reg = build_registry(setup, rows)
     options = FitOptions(max_iter=setup.max_iter, block=setup.block, edit_k=tuple(setup.edit_k),

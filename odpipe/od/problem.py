@@ -7,7 +7,7 @@ and :func:`odpipe.estimation.fit.fit`. Registry entries it understands
 
 ==============  =================================================================================
 state           epoch position/velocity (``registry.add_state``), relative to the force model centre
-dynamic         a force-model parameter: ``info['model']`` in ``srp_scale``, ``rho_s[k]``, ``rho_d[k]``
+dynamic         a force-model parameter: ``info['model']`` in ``srp_scale``, ``rho_s[k]``, ``rho_d[k]``, ``cd``
 stochastic      RTN accelerations (``registry.add_stochastic_acceleration``, axes R, T, N), m/s^2
 maneuver        impulsive ICRF dV (``registry.add_maneuver``; owner ``<sc>.<label>``), m/s
 maneuver_epoch  offset (s) of that maneuver's firing from its logged epoch (``add_maneuver(sigma_epoch=)``);
@@ -51,7 +51,7 @@ from dataclasses import dataclass, replace
 import numpy as np
 import pandas as pd
 
-from odpipe.dynamics.forces import EmpiricalRTN, ForceModel, SolarRadiationPressure
+from odpipe.dynamics.forces import AtmosphericDrag, EmpiricalRTN, ForceModel, SolarRadiationPressure
 from odpipe.measurements import MeasurementSetup, compute, residuals
 
 from .segment import SegmentTrajectory
@@ -179,6 +179,8 @@ class TrackingProblem:
                 surf = [replace(s, rho_s=values.get(f"rho_s[{k}]", s.rho_s), rho_d=values.get(f"rho_d[{k}]", s.rho_d))
                         for k, s in enumerate(c.surfaces)]
                 c = replace(c, scale=values.get("srp_scale", c.scale), surfaces=surf)
+            elif isinstance(c, AtmosphericDrag) and "cd" in values:
+                c = replace(c, cd=values["cd"])
             comps.append(c)
         names = [name for _, name in ix["dynamic"]]
         idx = [i for i, _ in ix["dynamic"]]

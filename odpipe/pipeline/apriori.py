@@ -39,7 +39,7 @@ def doppler_apriori(cfg: RunConfig, how: DopplerAprioriSection | None = None) ->
     fields = [g for g in cfg.dynamics.gravity if g.body.lower() == center]
     if not fields:
         raise ConfigError(cfg.path, "dynamics.gravity", f"an a priori orbit from Doppler needs a field of {center}")
-    data = ingest(list(cfg.data.files))
+    data = ingest(list(cfg.data.files), spacecraft=cfg.arc.spacecraft)
     catalog = station_catalog(cfg)
     rows = doppler_rows(data.table, data.ramps, cfg.arc.spacecraft)
     t0, t1 = pd.Timestamp(cfg.arc.start), pd.Timestamp(cfg.arc.end)

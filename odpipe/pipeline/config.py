@@ -25,8 +25,8 @@ import numpy as np
 
 from odpipe.estimation.fit import FitOptions
 from odpipe.od.arc import DATA_SIGMA, ArcSetup
-from odpipe.operations.schema import (at_least, between, checked, file_name, internal, load, positive, read_toml,
-                                readable, readable_files)
+from odpipe.operations.schema import (at_least, between, checked, file_name, finite, internal, load, positive,
+                                      read_toml, readable, readable_files)
 
 
 @functools.cache
@@ -117,11 +117,23 @@ class ArcSection:
 
 
 @dataclass
+class SinexSection:
+    """Stations of a SINEX solution (e.g. ILRS SLRF2014), named by site code ('7090'), added to the catalog."""
+
+    # SINEX with SITE/ID and SOLUTION/ESTIMATE positions (velocities: plate motion from the reference epoch)
+    file: Path = checked(_files_of(lambda: ("parsers.sinex",), "SINEX"))
+    # SINEX SITE/ECCENTRICITY file: each marker moved to its instrument's reference point
+    eccentricities: Path | None = checked(_files_of(lambda: ("parsers.sinex",), "SINEX"), default=None)
+    epoch: str | None = checked(utc_time, default=None)  # UTC time choosing solution and eccentricity (none: arc start)
+
+
+@dataclass
 class DataSection:
     # tracking files (globs allowed): any format parsers.formats reads as tracking data, or TrackingTable .parquet
     files: list[Path] = checked(_files_of(tracking_readers, "tracking"))
     # station CSVs added to the default catalog
     stations: list[Path] = checked(readable_files, default_factory=list)
+    sinex: SinexSection | None = None  # stations from a SINEX solution (none: catalog and CSVs only)
     # observables fitted; "observable:BAND" keeps only rows of that downlink band (e.g. "doppler_1way:X")
     observables: list[str] = field(default_factory=lambda: ["doppler_2way", "range"])
     errors: Literal["raise", "report"] = "report"  # nightly: report a corrupt record and go on
@@ -155,6 +167,8 @@ class GravitySection:
     file: Path = checked(readable_files)  # ICGEM, GMAT .cof, PDS SHADR, EGM or plain-table field
     degree: int = checked(at_least(0))  # degree and order evaluated
     partial_degree: int | None = checked(at_least(0), default=None)  # degree of the STM partials (none: degree)
+    # UTC time at which an ICGEM field's time-variable terms (gfct, trnd, acos, asin) are taken (none: arc start)
+    epoch: str | None = checked(utc_time, default=None)
 
 
 @dataclass
@@ -174,14 +188,42 @@ class SrpSection:
 
 
 @dataclass
+class DragSection:
+    """Atmospheric drag: Harris-Priester density, atmosphere co-rotating with the Earth (Earth-centred only)."""
+
+    cd: float = checked(finite)  # drag coefficient (the a priori when estimation.cd_sigma is set)
+    area: float = checked(positive)  # m², cross-section
+    n_bulge: float = checked(positive, default=6.0)  # Harris-Priester cosine exponent: 2 low, 6 high inclinations
+
+
+@dataclass
 class DynamicsSection:
     center: str  # central body of the integration, e.g. "earth", "moon", "ssb"
     ephemeris: str = "de440"  # 'de440', 'de421' or a .bsp path
     third_bodies: list[str] = field(default_factory=list)  # point masses, e.g. ["sun", "moon"]
     gravity: list[GravitySection] = field(default_factory=list)  # spherical-harmonic fields ([[dynamics.gravity]])
     srp: SrpSection | None = None  # solar radiation pressure (none: off)
+    drag: DragSection | None = None  # atmospheric drag (none: off)
     mass: float = checked(positive, default=1000.0)  # kg
     relativity: bool = False  # the central body's post-Newtonian term
+
+    def problems(self):
+        if self.drag is not None and self.center.lower() != "earth":
+            yield "drag", f"drag needs center = \"earth\", not {self.center!r}"
+
+
+@dataclass
+class MeasurementsSection:
+    """Corrections of the measurement models that belong to the spacecraft or the stations' antennas."""
+
+    # m: the ranging reflector (or antenna) this far ahead of the centre of mass towards the stations
+    # (LAGEOS 0.251): every range is that much shorter
+    com_offset: float = checked(finite, default=0.0)
+    # m: a fixed bias added to every range (transponder delay; Orekit's onboard.range.bias), not estimated
+    onboard_range_bias: float = checked(finite, default=0.0)
+    # angle_el rows are apparent elevations: the free-space one bent by the ITU-R P.834 refraction at the
+    # station's height
+    elevation_refraction: bool = False
 
 
 @dataclass
@@ -204,6 +246,9 @@ class InitialStateSection:
     from_oem: Path | None = None  # OEM whose state at epoch is the a priori (e.g. the previous arc's)
     # find the a priori orbit in the arc's own two-way Doppler (odpipe apriori); its epoch is the data's
     from_doppler: DopplerAprioriSection | None = None
+    # axes of ``state``: "ICRF" (GCRS about the Earth) or "EME2000" (mean equator and equinox of J2000,
+    # turned to ICRF by the IAU 2006 frame bias)
+    frame: Literal["ICRF", "EME2000"] = "ICRF"
 
     def problems(self):
         if sum(x is not None for x in (self.state, self.from_oem, self.from_doppler)) != 1:
@@ -212,6 +257,8 @@ class InitialStateSection:
             yield "state", "needs 6 finite numbers (m, m/s)"
         if self.epoch is None and self.from_doppler is None:
             yield "epoch", "required key is missing"
+        if self.frame != "ICRF" and self.state is None:
+            yield "frame", "only a given state takes a frame (an OEM names its own; from_doppler is ICRF)"
 
 
 @dataclass
@@ -219,6 +266,34 @@ class StochasticSection:
     sigma: float = checked(positive)  # m/s², steady state, per RTN axis
     tau: float = checked(at_least(0.0))  # s (0 = white per batch)
     batch: float = checked(positive)  # s
+
+
+@dataclass
+class OutwardSection:
+    """Fit outward from the a priori epoch: first the rows within ``first_hours`` of initial_state.epoch,
+    then windows ``factor`` times wider, each from the last one's estimate (with the a priori sigmas),
+    until the whole arc is fitted. For an a priori good at its epoch but far from the data's start (an
+    orbit propagated days back is kilometres off and the whole arc at once does not converge)."""
+
+    first_hours: float = checked(positive, default=12.0)  # h either side of the a priori epoch fitted first
+    factor: float = checked(between(1.01, 100.0), default=2.0)  # each next window this many times wider
+
+
+def _angles(value, positive_only: bool = False) -> list[tuple[str, str]]:
+    """Check: an angle (a number in rad, or a string with its unit) or each of a table, finite (and > 0)."""
+    from odpipe.od.arc import sigma_value  # the fit's own reading of angles (imports numerics: only when checked)
+
+    out = []
+    for key, v in (value.items() if isinstance(value, dict) else [("", value)]):
+        where = f".{key}" if key else ""
+        try:
+            x = sigma_value("angle_", v)
+        except ValueError as exc:
+            out.append((where, str(exc)))
+            continue
+        if not (np.isfinite(x) and (x > 0 or not positive_only)):
+            out.append((where, f"{v!r} must be {'positive and ' if positive_only else ''}finite"))
+    return out
 
 
 @dataclass
@@ -233,6 +308,16 @@ class EstimationSection:
                                                  default_factory=lambda: dict(DATA_SIGMA))
     # m, a per-pass range bias (none: not estimated)
     range_bias_sigma: float | None = checked(positive, default=ArcSetup.range_bias_sigma)
+    # one range bias per pass and station, or one per station over the arc (SLR, Orekit's station biases)
+    range_bias_per: Literal["pass", "station"] = ArcSetup.range_bias_per
+    # m, a priori range bias by receiving station (the others 0), e.g. { Fucino = 13468.956 }
+    range_bias_apriori: dict[str, float] = checked(finite, default_factory=dict)
+    # a priori sigma of one constant bias per station and angle observable: rad, or with its unit ("0.5 deg")
+    angle_bias_sigma: float | str | None = checked(lambda v: _angles(v, positive_only=True), default=None)
+    # a priori angle biases by "observable:station" or "observable" (the station's entry wins): rad or with
+    # its unit, e.g. { angle_az = "0.01 deg" } (the others 0)
+    angle_bias_apriori: dict[str, float | str] = checked(_angles, default_factory=dict)
+    cd_sigma: float | None = checked(positive, default=None)  # a priori sigma of the drag Cd (none: fixed)
     # one-way Doppler's oscillator, estimated when set: sigmas of its fractional frequency offset y0 and drift
     # y1 (1/s) about the arc start, one pair for every band it drives (a priori 0: the rows' reference)
     oscillator_sigma: list[float] | None = checked(positive, default=None)
@@ -252,8 +337,12 @@ class EstimationSection:
     # unlogged maneuvers: the filter's innovations are always tested (findings in the report); with a sigma
     # (m/s per axis) each finding also becomes an estimated impulsive maneuver and the arc is fitted again
     detected_maneuver_sigma: float | None = checked(positive, default=None)
+    outward: OutwardSection | None = None  # fit outward from the a priori epoch (none: the whole arc at once)
 
     def problems(self):
+        for key in self.angle_bias_apriori:
+            if key.split(":")[0] not in ("angle_az", "angle_el", "angle_x", "angle_y"):
+                yield f"angle_bias_apriori.{key}", "not an angle observable (angle_az, angle_el, angle_x, angle_y)"
         if not self.sigma_scale:
             yield "sigma_scale", "needs at least one stage"
         if not self.edit_k:
@@ -278,11 +367,21 @@ class RunConfig:
     dynamics: DynamicsSection
     initial_state: InitialStateSection
     calibration: CalibrationSection = field(default_factory=CalibrationSection)
+    measurements: MeasurementsSection = field(default_factory=MeasurementsSection)
     preprocess: PreprocessSection = field(default_factory=PreprocessSection)
     estimation: EstimationSection = field(default_factory=EstimationSection)
     products: ProductsSection = field(default_factory=ProductsSection)
     path: Path | None = internal(None)  # the file read (set by load_config)
     text: str = internal("")  # its text
+
+    def problems(self):
+        est = self.estimation
+        if est.cd_sigma is not None and self.dynamics.drag is None:
+            yield "estimation.cd_sigma", "needs [dynamics.drag] (no drag to estimate a Cd of)"
+        if est.outward is not None and self.initial_state.epoch is None:
+            yield "estimation.outward", "needs initial_state.epoch (the fit grows outward from it)"
+        if est.angle_bias_apriori and est.angle_bias_sigma is None:
+            yield "estimation.angle_bias_apriori", "needs estimation.angle_bias_sigma (biases are not estimated)"
 
 
 def load_config(path) -> RunConfig:

@@ -4,7 +4,8 @@ Each file's format is detected (:mod:`parsers.formats`); a ``.parquet`` file
 is a TrackingTable the project wrote itself (:mod:`odpipe.preprocess.store`,
 ramps beside it), so any stage's output can feed a run. In ``errors="report"``
 mode a corrupt record is reported with its file and offset and skipped; a file
-no reader recognises is reported and skipped; nothing else is lost.
+no reader recognises is reported and skipped; nothing else is lost. Files that
+name no spacecraft (Orekit's ``.aer`` tables) have their rows given the run's.
 """
 
 from __future__ import annotations
@@ -36,8 +37,9 @@ def _read(path: Path, errors: str) -> TrackingData:
     return read_any(path, errors=errors)
 
 
-def ingest(files: list[Path], errors: str = "report") -> Ingested:
-    """Read ``files``; rows sorted by time tag (stable), index renumbered from 0."""
+def ingest(files: list[Path], errors: str = "report", spacecraft: str = "") -> Ingested:
+    """Read ``files``; rows sorted by time tag (stable), index renumbered from 0; rows naming no
+    spacecraft take ``spacecraft``."""
     tables, ramps, log = [], [], []
     for path in files:
         try:
@@ -59,6 +61,11 @@ def ingest(files: list[Path], errors: str = "report") -> Ingested:
     if not tables:
         raise ValueError("no tracking data could be read from " + ", ".join(map(str, files)))
     table = pd.concat(tables, ignore_index=True).sort_values("epoch", kind="stable").reset_index(drop=True)
+    if spacecraft:
+        unnamed = table["spacecraft"].astype(str) == ""
+        table.loc[unnamed, "spacecraft"] = spacecraft
+        if unnamed.any():
+            log.append(f"{int(unnamed.sum())} rows naming no spacecraft given the run's, {spacecraft}")
     ramp_table = pd.concat(ramps, ignore_index=True) if ramps else empty_ramps()
     store = RampStore(ramp_table)
     if len(store.findings):

@@ -95,7 +95,7 @@ def run_config(path, *, force: bool = False, progress=print) -> dict:
 
 
 def _run(cfg: RunConfig, attempt, log: RunLog, fingerprint: dict) -> dict:
-    data = ingest(cfg.data.files, cfg.data.errors)
+    data = ingest(cfg.data.files, cfg.data.errors, cfg.arc.spacecraft)
     for line in data.log:
         log(line)
     table = data.table[data.table["spacecraft"].astype(str) == cfg.arc.spacecraft].reset_index(drop=True)
@@ -113,9 +113,12 @@ def _run(cfg: RunConfig, attempt, log: RunLog, fingerprint: dict) -> dict:
     if cal.media:
         model = MediaModel(read_trk223(*cal.tro, *cal.ion) if (cal.tro or cal.ion) else None,
                            IonexModel(read_ionex(*cal.ionex)) if cal.ionex else None)
-        table, _ = calibrate(table, model, target_itrs=apparent_itrs(apriori, fm.ephemeris), ramps=data.store,
-                             catalog=catalog,
-                             order=None if cal.smoothing_order < 0 else cal.smoothing_order)
+
+        def media(rows, trajectory):
+            return calibrate(rows, model, target_itrs=apparent_itrs(trajectory, fm.ephemeris), ramps=data.store,
+                             catalog=catalog, order=None if cal.smoothing_order < 0 else cal.smoothing_order)[0]
+
+        table = media(table, apriori)
         log(f"calibrate: media on {int(np.isfinite(table['media_m']).sum())} rows; "
             f"sources {dict(table['media_source'].value_counts().head(4))}")
     else:
@@ -136,6 +139,12 @@ def _run(cfg: RunConfig, attempt, log: RunLog, fingerprint: dict) -> dict:
 
     t0 = time.perf_counter()
     arc = _fit(table, setup, log)
+    if setup.outward is not None and cal.media:
+        # the media came from the a priori orbit, far off away from its epoch: again from the fit, then refit
+        setup = replace(setup, state0=arc.states[0], outward=None)
+        table = media(table, build.a_priori_trajectory(setup))
+        log("calibrate: media again along the outward fit's orbit; the whole arc fitted again from it")
+        arc = _fit(table, setup, log)
     findings = unlogged_maneuvers(arc.residuals)
     log(f"innovation test for unlogged maneuvers: {len(findings)} finding(s)")
     sigma = cfg.estimation.detected_maneuver_sigma

@@ -13,9 +13,10 @@ from odpipe.environment.gravity import read_gravity
 from odpipe.environment.stations import StationCatalog
 from odpipe.estimation.registry import GaussMarkov
 from odpipe.frames.earth import gcrs_to_itrs
+from odpipe.frames.eme2000 import eme2000_to_gcrs
 from odpipe.frames.local import rtn_matrix
 from odpipe.measurements import MeasurementSetup
-from odpipe.od.arc import ArcSetup, ManeuverPlan
+from odpipe.od.arc import ArcSetup, ManeuverPlan, sigma_value
 from odpipe.pipeline.config import RunConfig
 from odpipe.operations.schema import ConfigError
 from odpipe.time import utc_to_tdb
@@ -35,7 +36,8 @@ def force_model(cfg: RunConfig) -> F.ForceModel:
     if dyn.third_bodies:
         comps.append(F.PointMasses(list(dyn.third_bodies)))
     for g in dyn.gravity:
-        comps.append(F.SphericalHarmonics(g.body, read_gravity(g.file), g.degree, g.partial_degree))
+        field = read_gravity(g.file, epoch=tdb(g.epoch or cfg.arc.start))
+        comps.append(F.SphericalHarmonics(g.body, field, g.degree, g.partial_degree))
     if dyn.srp is not None:
         surfaces = []
         if dyn.srp.cylinder is not None:
@@ -43,6 +45,8 @@ def force_model(cfg: RunConfig) -> F.ForceModel:
             axis = c.axis if isinstance(c.axis, str) else np.asarray(c.axis, float)
             surfaces.append(F.Cylinder(axis, c.radius, c.length, c.rho_s, c.rho_d))
         comps.append(F.SolarRadiationPressure(dyn.srp.cr_area, surfaces, tuple(dyn.srp.occulters)))
+    if dyn.drag is not None:
+        comps.append(F.AtmosphericDrag(dyn.drag.cd, dyn.drag.area, dyn.drag.n_bulge))
     if dyn.relativity:
         comps.append(F.Relativity())
     return F.ForceModel(dyn.center, comps, dyn.mass, eph)
@@ -85,10 +89,13 @@ def _vnb_matrix(x):
 
 
 def station_catalog(cfg: RunConfig) -> StationCatalog:
-    """The default catalog plus the run's own station files."""
+    """The default catalog plus the run's own station files, then the SINEX solution's sites."""
     catalog = StationCatalog.default()
     for path in cfg.data.stations:
         catalog = catalog.with_csv(path)
+    sx = cfg.data.sinex
+    if sx is not None:
+        catalog = catalog.with_sinex(sx.file, sx.epoch or cfg.arc.start, eccentricities=sx.eccentricities)
     return catalog
 
 
@@ -103,7 +110,7 @@ def initial_state(cfg: RunConfig) -> tuple[float, np.ndarray]:
         return result.epoch, result.state
     t_tdb = tdb(init.epoch)
     if init.from_oem is None:
-        return t_tdb, np.asarray(init.state, float)
+        return t_tdb, (eme2000_to_gcrs(init.state) if init.frame == "EME2000" else np.asarray(init.state, float))
     traj = oem_trajectory(init.from_oem)
     if traj.center != cfg.dynamics.center.lower():
         raise ConfigError(cfg.path, "initial_state.from_oem",
@@ -121,7 +128,11 @@ def arc_setup(cfg: RunConfig, fm: F.ForceModel, ramps, catalog: StationCatalog) 
     if abs(t_state - start) > 1e-6:  # move the a priori state to the arc start
         state0 = propagate(state0, t_state, start, fm, with_stm=False).state(start)[0]
     oscillators = {} if est.oscillator_sigma is None else {cfg.arc.spacecraft: (0.0, 0.0, start)}
-    meas = MeasurementSetup(fm.ephemeris, catalog, ramps=ramps, gcrs_to_itrs=gcrs_to_itrs, oscillators=oscillators)
+    m = cfg.measurements
+    # a fixed onboard range bias lengthens every range as a reflector that far behind the centre of mass would
+    com = {cfg.arc.spacecraft: m.com_offset - m.onboard_range_bias} if m.com_offset or m.onboard_range_bias else {}
+    meas = MeasurementSetup(fm.ephemeris, catalog, ramps=ramps, gcrs_to_itrs=gcrs_to_itrs, oscillators=oscillators,
+                            com_offsets=com, elevation_refraction=m.elevation_refraction)
     stochastic = None if est.stochastic is None else GaussMarkov(est.stochastic.tau, est.stochastic.sigma,
                                                                  est.stochastic.batch)
     return ArcSetup(spacecraft=cfg.arc.spacecraft, start=start, end=end, state0=state0, force_model=fm,
@@ -129,9 +140,21 @@ def arc_setup(cfg: RunConfig, fm: F.ForceModel, ramps, catalog: StationCatalog) 
                     srp_scale_sigma=est.srp_scale_sigma if cfg.dynamics.srp is not None else None,
                     stochastic=stochastic, maneuvers=tuple(maneuver_plans(cfg, fm, state0, start)),
                     data_sigma=dict(est.data_sigma), range_bias_sigma=est.range_bias_sigma,
+                    range_bias_per=est.range_bias_per, bias_apriori=bias_apriori(est),
+                    angle_bias_sigma=None if est.angle_bias_sigma is None
+                    else sigma_value("angle_", est.angle_bias_sigma),
+                    cd_sigma=est.cd_sigma if cfg.dynamics.drag is not None else None,
+                    outward=None if est.outward is None else (t_state, est.outward.first_hours * 3600.0,
+                                                               est.outward.factor),
                     oscillator_sigma=None if est.oscillator_sigma is None else tuple(est.oscillator_sigma),
                     edit_k=tuple(est.edit_k), max_iter=est.max_iter, reweight=est.reweight,
                     sigma_scale=tuple(est.sigma_scale), block=est.block)
+
+
+def bias_apriori(est) -> dict:
+    """The a priori biases of the configuration as ArcSetup.bias_apriori: m for ranges, rad for angles."""
+    out = {f"range:{st}": v for st, v in est.range_bias_apriori.items()}
+    return out | {k: sigma_value("angle_", v) for k, v in est.angle_bias_apriori.items()}
 
 
 def a_priori_trajectory(setup: ArcSetup):
@@ -146,6 +169,8 @@ def input_files(cfg: RunConfig) -> list:
     """Every file whose bytes decide the run's result."""
     files = list(cfg.data.files) + cfg.data.stations + cfg.calibration.tro + cfg.calibration.ion + cfg.calibration.ionex
     files += [g.file for g in cfg.dynamics.gravity]
+    if cfg.data.sinex is not None:
+        files += [f for f in (cfg.data.sinex.file, cfg.data.sinex.eccentricities) if f is not None]
     if cfg.estimation.maneuver_plan is not None:
         files.append(cfg.estimation.maneuver_plan)
     if cfg.initial_state.from_oem is not None:

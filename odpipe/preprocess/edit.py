@@ -92,6 +92,7 @@ def invalid(table: pd.DataFrame) -> np.ndarray:
 
 def blunders(table: pd.DataFrame, config: EditConfig | None = None, use: np.ndarray | None = None) -> np.ndarray:
     """Gross outliers per pass (``pass_id`` must be set); only rows with ``use`` true are tested.
+    Azimuths are unwrapped within each pass (its rows in time order) before they are tested.
 
     Ambiguous (modular) range is left to the fit, where it is resolved against the model.
     """
@@ -102,6 +103,10 @@ def blunders(table: pd.DataFrame, config: EditConfig | None = None, use: np.ndar
     # one group per (link, pass): never judge one observable's values against another's
     pid = pd.Series(link_id(table)).astype(str).add(":").add(table["pass_id"].astype(str).to_numpy())
     pid = pd.factorize(pid)[0]
+    az = (table["observable"].to_numpy() == "angle_az") & np.isfinite(v)
+    if az.any():  # azimuths crossing north unwrapped within a pass: 359.9 deg then 0.1 deg is a 0.2 deg step
+        v = v.copy()
+        v[az] = pd.Series(v[az]).groupby(pid[az]).transform(np.unwrap).to_numpy()
     bad = use & gross(v, pid, config.gross_k, use)
     return bad | spikes(_ns(table), v, pid, config.blunder_k, use & ~bad)
 

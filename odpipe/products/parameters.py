@@ -2,7 +2,8 @@
 
 A fit's parameter table has columns ``name``, ``kind``, ``apriori``,
 ``estimate``, ``sigma`` in SI units (:mod:`odpipe.estimation.registry`). For
-a reader they are grouped by unit: positions and biases in m to the mm,
+a reader they are grouped by unit: positions and biases in m to the mm, angle biases (rad) in deg to
+1e-6 deg,
 velocities in m/s to the µm/s, ΔV in mm/s to the µm/s, maneuver epoch offsets
 in s to the ms, stochastic accelerations in m/s² and drifts in 1/s to 4
 significant figures, scale factors to 1e-5.
@@ -10,11 +11,13 @@ significant figures, scale factors to 1e-5.
 
 from __future__ import annotations
 
+import numpy as np
 import pandas as pd
 
 # (unit, factor from SI, format) of each display group
 _GROUPS = {
     "m": ("m", 1.0, "{:.3f}"),
+    "rad": ("deg", 180.0 / np.pi, "{:.6f}"),
     "m/s": ("m/s", 1.0, "{:.6f}"),
     "dv": ("mm/s", 1e3, "{:.3f}"),
     "s": ("s", 1.0, "{:.3f}"),
@@ -22,7 +25,7 @@ _GROUPS = {
     "1/s": ("1/s", 1.0, "{:.4g}"),
     "1": ("1", 1.0, "{:.5f}"),
 }
-_TITLES = {"m": "positions, station coordinates and range biases", "m/s": "velocities",
+_TITLES = {"m": "positions, station coordinates and range biases", "rad": "angle biases", "m/s": "velocities",
            "dv": "maneuver ΔV components", "s": "maneuver epoch offsets", "m/s2": "stochastic accelerations",
            "1/s": "frequency drifts", "1": "scale factors and fractional offsets"}
 
@@ -31,6 +34,8 @@ def group(name: str, kind: str) -> str:
     """The display group (a key of the unit table) of parameter ``name`` of ``kind``."""
     if kind == "state":
         return "m/s" if name.rsplit(".", 1)[-1].startswith("v") else "m"
+    if kind == "bias" and name.startswith("bias.angle_"):
+        return "rad"
     if kind in ("bias", "station"):
         return "m"
     if kind == "maneuver":
