@@ -1,0 +1,103 @@
+"""Spherical-harmonic gravity of a body as a registered force.
+
+The field acts in the body-fixed frame: the ICRF-to-body-fixed rotation is
+tabulated once per arc (:mod:`odpipe.numerics.chebyshev`) and the kernel of
+:mod:`odpipe.dynamics.harmonics` is evaluated at the rotated position relative to
+the body. The field replaces the body's point mass (a third body keeps its
+point-mass indirect term, :mod:`odpipe.dynamics.pointmass`).
+"""
+
+from __future__ import annotations
+
+from collections import namedtuple
+from dataclasses import dataclass
+from typing import Callable
+
+import numpy as np
+
+from odpipe.dynamics.harmonics import by_order, recursion_factors, sh_acceleration
+from odpipe.dynamics.registry import Force, kernel
+from odpipe.environment.gravity import GravityField
+from odpipe.numerics.chebyshev import evaluate, fit_channel, stack_channels
+
+ROTATION_GRID = {"earth": (3600.0, 12), "moon": (86400.0, 12)}  # s per segment, degree
+
+
+@dataclass
+class SphericalHarmonics:
+    """``rotation(t_tdb) -> (N,3,3)`` ICRF-to-body-fixed; default ITRS (Earth) / DE421 PA (Moon).
+
+    ``partial_degree``: degree of the gradient for the STM (default ``degree``)."""
+
+    body: str
+    field: GravityField
+    degree: int
+    partial_degree: int | None = None
+    rotation: Callable | None = None
+
+
+# Per field k: C[k], S[k] by order (see harmonics.by_order); gm (m^3/s^2), radius (m),
+# degree, grad_degree (-1: no gradient), slot (env.pos row, -1: the centre); the
+# rotation table (channel k); fac from harmonics.recursion_factors.
+HarmonicsData = namedtuple("HarmonicsData", ["C", "S", "gm", "radius", "degree", "grad_degree", "slot",
+                                             "rot_coefs", "rot_meta", "fac"])
+
+
+def default_rotation(body: str) -> Callable:
+    """ICRF-to-body-fixed rotation ``(N,) TDB s -> (N, 3, 3)`` for the Earth and the Moon."""
+    if body == "earth":
+        from odpipe.frames.earth import gcrs_to_itrs
+
+        return gcrs_to_itrs
+    if body == "moon":
+        from odpipe.frames.moon import moon_pa_to_icrf
+
+        return lambda t: np.swapaxes(moon_pa_to_icrf(t), -1, -2)
+    raise ValueError(f"no default body-fixed frame for {body!r}; give SphericalHarmonics.rotation")
+
+
+def _compile(components, ctx) -> HarmonicsData:
+    nmax_all = max([s.degree for s in components] + [2])
+    C = np.zeros((max(1, len(components)), nmax_all + 1, nmax_all + 1))
+    S = np.zeros_like(C)
+    n = len(components)
+    gm, radius = np.zeros(n), np.zeros(n)
+    degree, grad_degree, slot = (np.zeros(n, dtype=np.int64) for _ in range(3))
+    channels = []
+    for k, s in enumerate(components):
+        g = s.field.truncated(s.degree)
+        C[k, : s.degree + 1, : s.degree + 1] = by_order(g.C)
+        S[k, : s.degree + 1, : s.degree + 1] = by_order(g.S)
+        body = s.body.lower()
+        rot = s.rotation or default_rotation(body)
+        seg, deg = ROTATION_GRID.get(body, (3600.0, 12))
+        channels.append(fit_channel(lambda t, rot=rot: np.asarray(rot(t)).reshape(-1, 9), ctx.lo, ctx.hi, seg, deg))
+        gm[k], radius[k], degree[k] = g.gm, g.radius, s.degree
+        grad_degree[k] = (s.degree if s.partial_degree is None else s.partial_degree) if ctx.with_stm else -1
+        slot[k] = ctx.slot.get(body, -1) if body != ctx.center else -1
+    rot_coefs, rot_meta = stack_channels(channels)
+    return HarmonicsData(C, S, gm, radius, degree, grad_degree, slot, rot_coefs, rot_meta,
+                         recursion_factors(max(nmax_all, 2)))
+
+
+@kernel(HarmonicsData)
+def _kernel(data, t, r, v, env, acc, grad_r, grad_v, dadp):
+    rot = np.empty(9)
+    a_bf = np.empty(3)
+    g_bf = np.zeros((3, 3))
+    for k in range(data.gm.shape[0]):
+        slot = data.slot[k]
+        rel = r - env.pos[slot] if slot >= 0 else r.copy()
+        evaluate(data.rot_coefs, data.rot_meta, k, t, rot)
+        M = rot.reshape((3, 3))
+        ngrad = data.grad_degree[k]
+        sh_acceleration(M @ rel, data.gm[k], data.radius[k], data.C[k], data.S[k], data.degree[k], ngrad,
+                        data.fac, a_bf, g_bf)
+        acc += M.T @ a_bf
+        if ngrad >= 0:
+            grad_r += M.T @ g_bf @ M
+
+
+HARMONICS = Force("harmonics", (SphericalHarmonics,), _compile,
+                  bodies=lambda components, center: [s.body.lower() for s in components
+                                                     if s.body.lower() != center])
