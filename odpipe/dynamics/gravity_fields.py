@@ -15,7 +15,7 @@ from typing import Callable
 
 import numpy as np
 
-from odpipe.dynamics.harmonics import by_order, recursion_factors, sh_acceleration
+from odpipe.dynamics.harmonics import ROWS, field_table, sh_acceleration
 from odpipe.dynamics.registry import Force, kernel
 from odpipe.environment.gravity import GravityField
 from odpipe.numerics.chebyshev import evaluate, fit_channel, stack_channels
@@ -36,11 +36,10 @@ class SphericalHarmonics:
     rotation: Callable | None = None
 
 
-# Per field k: C[k], S[k] by order (see harmonics.by_order); gm (m^3/s^2), radius (m),
-# degree, grad_degree (-1: no gradient), slot (env.pos row, -1: the centre); the
-# rotation table (channel k); fac from harmonics.recursion_factors.
-HarmonicsData = namedtuple("HarmonicsData", ["C", "S", "gm", "radius", "degree", "grad_degree", "slot",
-                                             "rot_coefs", "rot_meta", "fac"])
+# Per field k: its packed table start[k], T[k] (harmonics.field_table); gm (m^3/s^2), radius (m),
+# degree, grad_degree (-1: no gradient), slot (env.pos row, -1: the centre); the rotation table (channel k).
+HarmonicsData = namedtuple("HarmonicsData", ["start", "T", "gm", "radius", "degree", "grad_degree", "slot",
+                                             "rot_coefs", "rot_meta"])
 
 
 def default_rotation(body: str) -> Callable:
@@ -57,17 +56,13 @@ def default_rotation(body: str) -> Callable:
 
 
 def _compile(components, ctx) -> HarmonicsData:
-    nmax_all = max([s.degree for s in components] + [2])
-    C = np.zeros((max(1, len(components)), nmax_all + 1, nmax_all + 1))
-    S = np.zeros_like(C)
     n = len(components)
     gm, radius = np.zeros(n), np.zeros(n)
     degree, grad_degree, slot = (np.zeros(n, dtype=np.int64) for _ in range(3))
+    tables = []
     channels = []
     for k, s in enumerate(components):
         g = s.field.truncated(s.degree)
-        C[k, : s.degree + 1, : s.degree + 1] = by_order(g.C)
-        S[k, : s.degree + 1, : s.degree + 1] = by_order(g.S)
         body = s.body.lower()
         rot = s.rotation or default_rotation(body)
         seg, deg = ROTATION_GRID.get(body, (3600.0, 12))
@@ -75,9 +70,13 @@ def _compile(components, ctx) -> HarmonicsData:
         gm[k], radius[k], degree[k] = g.gm, g.radius, s.degree
         grad_degree[k] = (s.degree if s.partial_degree is None else s.partial_degree) if ctx.with_stm else -1
         slot[k] = ctx.slot.get(body, -1) if body != ctx.center else -1
+        tables.append(field_table(g.C, g.S, s.degree, int(grad_degree[k])))
     rot_coefs, rot_meta = stack_channels(channels)
-    return HarmonicsData(C, S, gm, radius, degree, grad_degree, slot, rot_coefs, rot_meta,
-                         recursion_factors(max(nmax_all, 2)))
+    start = np.zeros((max(1, n), max([st.size for st, _ in tables] + [1])), dtype=np.int64)
+    T = np.zeros((max(1, n), ROWS, max([t.shape[1] for _, t in tables] + [1])))
+    for k, (st, t) in enumerate(tables):
+        start[k, : st.size], T[k, :, : t.shape[1]] = st, t
+    return HarmonicsData(start, T, gm, radius, degree, grad_degree, slot, rot_coefs, rot_meta)
 
 
 @kernel(HarmonicsData)
@@ -91,8 +90,8 @@ def _kernel(data, t, r, v, env, acc, grad_r, grad_v, dadp):
         evaluate(data.rot_coefs, data.rot_meta, k, t, rot)
         M = rot.reshape((3, 3))
         ngrad = data.grad_degree[k]
-        sh_acceleration(M @ rel, data.gm[k], data.radius[k], data.C[k], data.S[k], data.degree[k], ngrad,
-                        data.fac, a_bf, g_bf)
+        sh_acceleration(M @ rel, data.gm[k], data.radius[k], data.start[k], data.T[k], data.degree[k], ngrad,
+                        a_bf, g_bf)
         acc += M.T @ a_bf
         if ngrad >= 0:
             grad_r += M.T @ g_bf @ M
