@@ -15,7 +15,7 @@ from typing import Callable
 
 import numpy as np
 
-from odpipe.dynamics.harmonics import ROWS, field_table, sh_acceleration
+from odpipe.dynamics.harmonics import ROWS, field_table, sh_acceleration, workspace
 from odpipe.dynamics.registry import Force, kernel
 from odpipe.environment.gravity import GravityField
 from odpipe.numerics.chebyshev import evaluate, fit_channel, stack_channels
@@ -37,9 +37,11 @@ class SphericalHarmonics:
 
 
 # Per field k: its packed table start[k], T[k] (harmonics.field_table); gm (m^3/s^2), radius (m),
-# degree, grad_degree (-1: no gradient), slot (env.pos row, -1: the centre); the rotation table (channel k).
+# degree, grad_degree (-1: no gradient), slot (env.pos row, -1: the centre); the rotation table (channel k);
+# the kernel's scratch array (harmonics.workspace for the largest field, then 36 for the frame changes).
 HarmonicsData = namedtuple("HarmonicsData", ["start", "T", "gm", "radius", "degree", "grad_degree", "slot",
-                                             "rot_coefs", "rot_meta"])
+                                             "rot_coefs", "rot_meta", "work"])
+FRAME_SCRATCH = 36
 
 
 def default_rotation(body: str) -> Callable:
@@ -76,25 +78,39 @@ def _compile(components, ctx) -> HarmonicsData:
     T = np.zeros((max(1, n), ROWS, max([t.shape[1] for _, t in tables] + [1])))
     for k, (st, t) in enumerate(tables):
         start[k, : st.size], T[k, :, : t.shape[1]] = st, t
-    return HarmonicsData(start, T, gm, radius, degree, grad_degree, slot, rot_coefs, rot_meta)
+    work = np.concatenate([workspace(int(degree.max(initial=2)), int(grad_degree.max(initial=-1))),
+                           np.zeros(FRAME_SCRATCH)])
+    return HarmonicsData(start, T, gm, radius, degree, grad_degree, slot, rot_coefs, rot_meta, work)
 
 
 @kernel(HarmonicsData)
 def _kernel(data, t, r, v, env, acc, grad_r, grad_v, dadp):
-    rot = np.empty(9)
-    a_bf = np.empty(3)
-    g_bf = np.zeros((3, 3))
+    sc = data.work[data.work.shape[0] - FRAME_SCRATCH:]  # no allocation per evaluation
+    M = sc[0:9].reshape((3, 3))  # ICRF -> body-fixed
+    rel = sc[9:12]
+    r_bf = sc[12:15]
+    a_bf = sc[15:18]
+    g_bf = sc[18:27].reshape((3, 3))
+    gM = sc[27:36].reshape((3, 3))
     for k in range(data.gm.shape[0]):
         slot = data.slot[k]
-        rel = r - env.pos[slot] if slot >= 0 else r.copy()
-        evaluate(data.rot_coefs, data.rot_meta, k, t, rot)
-        M = rot.reshape((3, 3))
+        for i in range(3):
+            rel[i] = r[i] - env.pos[slot, i] if slot >= 0 else r[i]
+        evaluate(data.rot_coefs, data.rot_meta, k, t, sc[0:9])
+        for i in range(3):
+            r_bf[i] = M[i, 0] * rel[0] + M[i, 1] * rel[1] + M[i, 2] * rel[2]
         ngrad = data.grad_degree[k]
-        sh_acceleration(M @ rel, data.gm[k], data.radius[k], data.start[k], data.T[k], data.degree[k], ngrad,
-                        a_bf, g_bf)
-        acc += M.T @ a_bf
-        if ngrad >= 0:
-            grad_r += M.T @ g_bf @ M
+        sh_acceleration(r_bf, data.gm[k], data.radius[k], data.start[k], data.T[k], data.degree[k], ngrad,
+                        data.work, a_bf, g_bf)
+        for i in range(3):
+            acc[i] += M[0, i] * a_bf[0] + M[1, i] * a_bf[1] + M[2, i] * a_bf[2]
+        if ngrad >= 0:  # M^T g M
+            for i in range(3):
+                for j in range(3):
+                    gM[i, j] = g_bf[i, 0] * M[0, j] + g_bf[i, 1] * M[1, j] + g_bf[i, 2] * M[2, j]
+            for i in range(3):
+                for j in range(3):
+                    grad_r[i, j] += M[0, i] * gM[0, j] + M[1, i] * gM[1, j] + M[2, i] * gM[2, j]
 
 
 HARMONICS = Force("harmonics", (SphericalHarmonics,), _compile,

@@ -91,6 +91,9 @@ ACC = 3  # a_x: rows ACC, ACC+1 (V, W); a_y: ACC+2, ACC+3; a_z: ACC+4, ACC+5
 GRAD = 9  # gradient element e in GRAD_ELEMENTS: rows GRAD + 2e (V), GRAD + 2e + 1 (W)
 GRAD_ELEMENTS = ((0, 0), (0, 1), (0, 2), (1, 1), (1, 2), (2, 2))
 ROWS = GRAD + 2 * len(GRAD_ELEMENTS)
+# V rows of the acceleration and of the gradient sums (arrays, not literal ints: one compiled signature)
+ACC_ROWS = np.arange(ACC, GRAD, 2)
+GRAD_ROWS = np.arange(GRAD, ROWS, 2)
 
 
 def field_table(C: np.ndarray, S: np.ndarray, nmax: int, ngrad: int) -> tuple[np.ndarray, np.ndarray]:
@@ -135,27 +138,27 @@ BLOCK = 4  # columns built together: independent recursions the CPU overlaps
 
 @njit(cache=True)
 def _step(k, j, n, start, T, zr, rr, Vb, Wb):
-    """V, W of degree n in column k (buffer row j) from degrees n-1 and n-2."""
+    """V, W of degree n in column k (buffer row j, degree n at index n + 1) from degrees n-1 and n-2."""
     i = np.uint64(start[k] + n - k)
     a = T[RA, i] * zr
     b = T[RB, i] * rr
-    Vb[j, n] = a * Vb[j, n - 1] - b * Vb[j, n - 2]
-    Wb[j, n] = a * Wb[j, n - 1] - b * Wb[j, n - 2]
+    Vb[j, n + 1] = a * Vb[j, n] - b * Vb[j, n - 1]
+    Wb[j, n + 1] = a * Wb[j, n] - b * Wb[j, n - 1]
 
 
 @njit(cache=True)
 def _columns(k0, k1, ntop, start, T, zr, rr, Vs, Ws, Vb, Wb):
-    """Columns k0 <= k < k1 (at most BLOCK) of V, W, degrees k..ntop, into buffer rows k - k0.
+    """Columns k0 <= k < k1 (at most BLOCK) of V, W, degrees k..ntop, into buffer rows k - k0
+    (degree n at index n + 1).
 
-    Starts from the sectorals Vs, Ws; f1 of (k, k+1) is 0, so entry k-1 (set to 0) starts
+    Starts from the sectorals Vs, Ws; f1 of (k, k+1) is 0, so degree k-1 (set to 0) starts
     each column. A full block's four recursions run in registers, interleaved.
     """
     for k in range(k0, k1):
-        Vb[k - k0, k] = Vs[k]
-        Wb[k - k0, k] = Ws[k]
-        if k > 0:
-            Vb[k - k0, k - 1] = 0.0
-            Wb[k - k0, k - 1] = 0.0
+        Vb[k - k0, k + 1] = Vs[k]
+        Wb[k - k0, k + 1] = Ws[k]
+        Vb[k - k0, k] = 0.0
+        Wb[k - k0, k] = 0.0
     n0 = min(k0 + BLOCK, ntop + 1)
     for n in range(k0 + 1, n0):  # the staircase: column k starts at n = k + 1
         for k in range(k0, min(k1, n)):
@@ -165,10 +168,10 @@ def _columns(k0, k1, ntop, start, T, zr, rr, Vs, Ws, Vb, Wb):
             for k in range(k0, k1):
                 _step(k, k - k0, n, start, T, zr, rr, Vb, Wb)
         return
-    v0, v1, v2, v3 = Vb[0, n0 - 1], Vb[1, n0 - 1], Vb[2, n0 - 1], Vb[3, n0 - 1]
-    u0, u1, u2, u3 = Vb[0, n0 - 2], Vb[1, n0 - 2], Vb[2, n0 - 2], Vb[3, n0 - 2]
-    w0, w1, w2, w3 = Wb[0, n0 - 1], Wb[1, n0 - 1], Wb[2, n0 - 1], Wb[3, n0 - 1]
-    x0, x1, x2, x3 = Wb[0, n0 - 2], Wb[1, n0 - 2], Wb[2, n0 - 2], Wb[3, n0 - 2]
+    v0, v1, v2, v3 = Vb[0, n0], Vb[1, n0], Vb[2, n0], Vb[3, n0]
+    u0, u1, u2, u3 = Vb[0, n0 - 1], Vb[1, n0 - 1], Vb[2, n0 - 1], Vb[3, n0 - 1]
+    w0, w1, w2, w3 = Wb[0, n0], Wb[1, n0], Wb[2, n0], Wb[3, n0]
+    x0, x1, x2, x3 = Wb[0, n0 - 1], Wb[1, n0 - 1], Wb[2, n0 - 1], Wb[3, n0 - 1]
     i0, i1, i2, i3 = start[k0] - k0, start[k0 + 1] - k0 - 1, start[k0 + 2] - k0 - 2, start[k0 + 3] - k0 - 3
     for n in range(n0, ntop + 1):
         a0, b0 = T[RA, np.uint64(i0 + n)] * zr, T[RB, np.uint64(i0 + n)] * rr
@@ -179,21 +182,21 @@ def _columns(k0, k1, ntop, start, T, zr, rr, Vs, Ws, Vb, Wb):
         v1, u1, w1, x1 = a1 * v1 - b1 * u1, v1, a1 * w1 - b1 * x1, w1
         v2, u2, w2, x2 = a2 * v2 - b2 * u2, v2, a2 * w2 - b2 * x2, w2
         v3, u3, w3, x3 = a3 * v3 - b3 * u3, v3, a3 * w3 - b3 * x3, w3
-        un = np.uint64(n)
+        un = np.uint64(n + 1)
         Vb[0, un], Vb[1, un], Vb[2, un], Vb[3, un] = v0, v1, v2, v3
         Wb[0, un], Wb[1, un], Wb[2, un], Wb[3, un] = w0, w1, w2, w3
 
 
 @njit(cache=True, fastmath={"reassoc", "contract"})
-def _column_sums(k, n1, row0, nrows, start, T, V, W, out):
-    """Add sum over degrees k..n1 of T[row] V + T[row+1] W, for rows row0, row0+2, ..., to out[0 .. nrows).
+def _column_sums(k, n1, rows, start, T, V, W, out):
+    """Add sum over degrees k..n1 of T[row] V + T[row+1] W, for the V rows ``rows``, to out[0 .. len(rows)).
 
     Reassociated (fastmath) so that the sums vectorize; tested within 1e-12 of ordered sums.
     """
     i0 = start[k] - k
-    for e in range(nrows):
-        ra = np.uint64(row0 + 2 * e)
-        rb = np.uint64(row0 + 2 * e + 1)
+    for e in range(rows.shape[0]):
+        ra = np.uint64(rows[e])
+        rb = np.uint64(rows[e] + 1)
         total = 0.0
         for n in range(k, n1 + 1):
             i = np.uint64(i0 + n)
@@ -202,37 +205,50 @@ def _column_sums(k, n1, row0, nrows, start, T, V, W, out):
         out[e] += total
 
 
+def workspace(nmax: int, ngrad: int) -> np.ndarray:
+    """Scratch array for :func:`sh_acceleration` up to degree ``nmax``, gradient degree ``ngrad``."""
+    ntop = max(nmax + 1, ngrad + 2)
+    return np.zeros(2 * (ntop + 1) + 2 * BLOCK * (ntop + 2) + 9)
+
+
 @njit(cache=True)
-def sh_acceleration(r_bf, gm, radius, start, T, nmax, ngrad, acc, grad):
+def sh_acceleration(r_bf, gm, radius, start, T, nmax, ngrad, work, acc, grad):
     """Acceleration (m/s^2) into ``acc`` and, when ngrad >= 0, its gradient
     (1/s^2, symmetric 3x3, from degrees <= ngrad) into ``grad``, body-fixed, at ``r_bf`` (m).
 
     ``start``, ``T`` from :func:`field_table` of the field to degree ``nmax`` with gradient
-    degree ``ngrad`` (or higher). Includes the central term C00; degree 1 is skipped.
+    degree ``ngrad`` (or higher); ``work`` from :func:`workspace` (or larger), so that an
+    evaluation allocates nothing. Includes the central term C00; degree 1 is skipped.
     """
     ntop = nmax + 1 if ngrad < 0 else max(nmax + 1, ngrad + 2)
     r2 = r_bf[0] ** 2 + r_bf[1] ** 2 + r_bf[2] ** 2
     rho = radius / r2
     xr, yr, zr, rr = r_bf[0] * rho, r_bf[1] * rho, r_bf[2] * rho, radius * rho
-    Vs = np.empty(ntop + 1)  # sectorals V[k, k], W[k, k]
-    Ws = np.empty(ntop + 1)
+    Vs = work[: ntop + 1]  # sectorals V[k, k], W[k, k]
+    Ws = work[ntop + 1: 2 * ntop + 2]
+    nb = BLOCK * (ntop + 2)
+    # the block's columns, degree n at index n + 1: index 0 stays 0 (column 0's degree -1)
+    Vb = work[2 * ntop + 2: 2 * ntop + 2 + nb].reshape((BLOCK, ntop + 2))
+    Wb = work[2 * ntop + 2 + nb: 2 * ntop + 2 + 2 * nb].reshape((BLOCK, ntop + 2))
+    sums = work[2 * ntop + 2 + 2 * nb: 2 * ntop + 2 + 2 * nb + 9]  # a_x, a_y, a_z, the gradient elements
+    sums[:] = 0.0
+    Vb[0, 0] = 0.0
+    Wb[0, 0] = 0.0
     Vs[0] = radius / np.sqrt(r2)
     Ws[0] = 0.0
     for k in range(1, ntop + 1):
         f2 = T[RS, start[k]]
         Vs[k] = f2 * (xr * Vs[k - 1] - yr * Ws[k - 1])
         Ws[k] = f2 * (xr * Ws[k - 1] + yr * Vs[k - 1])
-    Vb = np.zeros((BLOCK, ntop + 1))  # zeros: column 0 reads its entry n-2 = -1 (times f1 = 0)
-    Wb = np.zeros((BLOCK, ntop + 1))
-    sums = np.zeros(9)  # a_x, a_y, a_z, then the gradient elements
     g = sums[3:]
     for k0 in range(0, ntop + 1, BLOCK):
         k1 = min(k0 + BLOCK, ntop + 1)
         _columns(k0, k1, ntop, start, T, zr, rr, Vs, Ws, Vb, Wb)
         for k in range(k0, k1):
-            _column_sums(k, min(nmax + 1, ntop), ACC, 3, start, T, Vb[k - k0], Wb[k - k0], sums)
+            V, W = Vb[k - k0, 1:], Wb[k - k0, 1:]
+            _column_sums(k, min(nmax + 1, ntop), ACC_ROWS, start, T, V, W, sums)
             if k <= ngrad + 2:
-                _column_sums(k, ngrad + 2, GRAD, len(GRAD_ELEMENTS), start, T, Vb[k - k0], Wb[k - k0], g)
+                _column_sums(k, ngrad + 2, GRAD_ROWS, start, T, V, W, g)
     c = gm / (radius * radius)
     for i in range(3):
         acc[i] = c * sums[i]

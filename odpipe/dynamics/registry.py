@@ -38,7 +38,7 @@ def kernel(data_class):
     """Register ``impl(data, t, r, v, env, acc, grad_r, grad_v, dadp)`` as ``contribute`` for ``data_class``."""
 
     def register(impl):
-        @overload(contribute)
+        @overload(contribute, inline="always")
         def _select(data, t, r, v, env, acc, grad_r, grad_v, dadp):
             if getattr(data, "instance_class", None) is data_class:
                 return impl
