@@ -12,6 +12,8 @@ A :class:`ForceModel` is a centre (NAIF name: 'earth', 'moon', 'sun', 'emb',
   conical shadows (:mod:`~odpipe.dynamics.srp`);
 * :class:`AtmosphericDrag` - Harris-Priester, Earth-centred models only (:mod:`~odpipe.dynamics.drag`);
 * :class:`EmpiricalRTN` - piecewise-constant RTN accelerations (:mod:`~odpipe.dynamics.empirical`);
+* :class:`InertialPolynomialAcceleration` - constant plus linear ICRF acceleration
+  (:mod:`~odpipe.dynamics.polynomial`);
 * :class:`FiniteBurn` - thrust with mass flow, and :class:`ImpulsiveManeuver`, a delta-v
   applied by the propagator (:mod:`~odpipe.dynamics.thrust`).
 
@@ -22,7 +24,8 @@ To add a force: a module with its component, data, compile step and kernel
 
 Estimable dynamic parameters (names used by ``Trajectory.param_names``), in canonical
 order: ``srp_scale``, ``rho_s[k]``/``rho_d[k]`` (surface k), ``cd`` (drag),
-``emp[b].R|T|N`` (batch b), ``dv[k].x|y|z`` and ``dv[k].t`` (impulsive maneuver k).
+``emp[b].R|T|N`` (batch b), ``poly[k].x0|y0|z0|x1|y1|z1`` (polynomial acceleration k),
+``dv[k].x|y|z`` and ``dv[k].t`` (impulsive maneuver k).
 """
 
 from __future__ import annotations
@@ -37,16 +40,17 @@ from odpipe.dynamics.drag import DRAG, AtmosphericDrag
 from odpipe.dynamics.empirical import EMPIRICAL, EmpiricalRTN
 from odpipe.dynamics.gravity_fields import HARMONICS, ROTATION_GRID, SphericalHarmonics
 from odpipe.dynamics.pointmass import CENTRAL, THIRD_BODIES, PointMasses
+from odpipe.dynamics.polynomial import POLYNOMIAL, InertialPolynomialAcceleration
 from odpipe.dynamics.registry import CompileContext
 from odpipe.dynamics.relativity import RELATIVITY, Relativity
 from odpipe.dynamics.srp import BODY_RADIUS, SRP, Cylinder, Plate, SolarRadiationPressure
 from odpipe.dynamics.thrust import BURNS, FiniteBurn, ImpulsiveManeuver, burn_rows
 
 __all__ = ["AtmosphericDrag", "BODY_RADIUS", "CompiledModel", "Cylinder", "EmpiricalRTN", "FORCES", "FiniteBurn",
-           "ForceModel", "ImpulsiveManeuver", "Plate", "PointMasses", "ROTATION_GRID", "Relativity",
-           "SolarRadiationPressure", "SphericalHarmonics", "compile_model"]
+           "ForceModel", "ImpulsiveManeuver", "InertialPolynomialAcceleration", "Plate", "PointMasses",
+           "ROTATION_GRID", "Relativity", "SolarRadiationPressure", "SphericalHarmonics", "compile_model"]
 
-FORCES = (CENTRAL, THIRD_BODIES, HARMONICS, RELATIVITY, SRP, DRAG, EMPIRICAL, BURNS)
+FORCES = (CENTRAL, THIRD_BODIES, HARMONICS, RELATIVITY, SRP, DRAG, EMPIRICAL, POLYNOMIAL, BURNS)
 Forces = namedtuple("Forces", [f.name for f in FORCES])
 
 # The arrays the numba right-hand side reads (odpipe.dynamics.rhs):
