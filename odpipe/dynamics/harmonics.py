@@ -42,11 +42,6 @@ def recursion_factors(nmax: int) -> np.ndarray:
     return f
 
 
-def by_order(C: np.ndarray) -> np.ndarray:
-    """Coefficients [n, m] of a GravityField re-stored as [m, n]."""
-    return np.ascontiguousarray(np.asarray(C).T)
-
-
 def _derivative(axis: int, a: np.ndarray, b: np.ndarray, f: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     """The functional sum a V + b W ([n, m], degrees <= N) differentiated along x, y or z (times R).
 
