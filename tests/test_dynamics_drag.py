@@ -47,7 +47,7 @@ def test_density_decays_exponentially_between_table_heights():
 
 
 def _accel(model, t, x):
-    npar = model[15].shape[0]
+    npar = model.n_params
     acc, gr, gv, dp = np.zeros(3), np.zeros((3, 3)), np.zeros((3, 3)), np.zeros((npar, 3))
     acceleration(t, x[:3].copy(), x[3:].copy(), model, acc, gr, gv, dp)
     return acc, gr, gv, dp

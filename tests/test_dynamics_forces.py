@@ -21,8 +21,8 @@ def eph():
 
 
 def _accel(model, t, x):
-    model[1][5] = t  # the segment containing t (selects empirical batch and burn)
-    npar = model[15].shape[0]
+    model.segment[0] = t  # the segment containing t (selects empirical batch and burn)
+    npar = model.n_params
     acc, gr, gv, dp = np.zeros(3), np.zeros((3, 3)), np.zeros((3, 3)), np.zeros((npar, 3))
     acceleration(t, x[:3].copy(), x[3:].copy(), model, acc, gr, gv, dp)
     return acc, gr, gv, dp

@@ -6,14 +6,15 @@ Public API: :func:`propagate`, :func:`propagate_many`, :class:`Trajectory`,
 """
 
 from odpipe.dynamics.crtbp import EarthMoonUnits, jacobi_constant, propagate_crtbp
-from odpipe.dynamics.forces import (Cylinder, EmpiricalRTN, FiniteBurn, ForceModel, ImpulsiveManeuver,
-                                    Plate, PointMasses, Relativity, SolarRadiationPressure,
-                                    SphericalHarmonics)
+from odpipe.dynamics.forces import (AtmosphericDrag, Cylinder, EmpiricalRTN, FiniteBurn, ForceModel,
+                                    ImpulsiveManeuver, InertialPolynomialAcceleration, Plate, PointMasses,
+                                    Relativity, SolarRadiationPressure, SphericalHarmonics)
 from odpipe.dynamics.propagator import propagate, propagate_many
 from odpipe.dynamics.trajectory import Trajectory, TrajectorySet
 
 __all__ = [
-    "Cylinder", "EarthMoonUnits", "EmpiricalRTN", "FiniteBurn", "ForceModel", "ImpulsiveManeuver", "Plate",
+    "AtmosphericDrag", "Cylinder", "EarthMoonUnits", "EmpiricalRTN", "FiniteBurn", "ForceModel", "ImpulsiveManeuver",
+    "InertialPolynomialAcceleration", "Plate",
     "PointMasses", "Relativity", "SolarRadiationPressure", "SphericalHarmonics", "Trajectory",
     "TrajectorySet", "jacobi_constant", "propagate", "propagate_crtbp", "propagate_many",
 ]

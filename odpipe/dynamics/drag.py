@@ -23,12 +23,30 @@ angle) and d a/d Cd = a/Cd (the estimable parameter 'cd').
 
 from __future__ import annotations
 
+from collections import namedtuple
+from dataclasses import dataclass
+
 import numpy as np
 from numba import njit
 
 from odpipe.constants import EARTH_ROTATION_RATE as OMEGA_EARTH, WGS84_A as R_EQUATOR, WGS84_F as FLATTENING
+from odpipe.dynamics.registry import Force, kernel
 
 BULGE_LAG = np.radians(30.0)
+
+
+@dataclass
+class AtmosphericDrag:
+    """Drag coefficient Cd (estimable parameter 'cd'), cross-section area (m^2);
+    Harris-Priester bulge exponent n (2 low, 6 polar orbits). Earth-centred models only."""
+
+    cd: float
+    area: float
+    n_bulge: float = 6.0
+
+
+# on; Cd; area m^2; bulge exponent; env.pos row of the Sun; d a/d p row of 'cd' (-1: not estimated)
+DragData = namedtuple("DragData", ["on", "cd", "area", "n_bulge", "sun_slot", "cd_row"])
 
 # height (km), minimum and maximum density (kg/m^3): M&G Table 3.8 (g/km^3 * 1e-12)
 HP_TABLE = np.array([
@@ -129,3 +147,27 @@ def drag_acceleration(r, v, r_sun, cd, area, mass, n_bulge, acc, grad_r, grad_v,
             grad_r[i, j] += k * s * vr[i] * drho[j]
         grad_r[i, 0] -= dav[i, 1] * OMEGA_EARTH
         grad_r[i, 1] += dav[i, 0] * OMEGA_EARTH
+
+
+def _compile(components, ctx) -> DragData:
+    if not components:
+        return DragData(False, 0.0, 0.0, 0.0, -1, -1)
+    if ctx.center != "earth":
+        raise ValueError("atmospheric drag needs an Earth-centred force model")
+    d = components[0]
+    return DragData(True, float(d.cd), float(d.area), float(d.n_bulge), ctx.slot["sun"], int(ctx.rows(["cd"])[0]))
+
+
+@kernel(DragData)
+def _kernel(data, t, r, v, env, acc, grad_r, grad_v, dadp):
+    if not data.on:
+        return
+    d_cd = np.zeros(3)
+    drag_acceleration(r, v, env.pos[data.sun_slot], data.cd, data.area, env.mass, data.n_bulge,
+                      acc, grad_r, grad_v, d_cd)
+    if data.cd_row >= 0:
+        dadp[data.cd_row] += d_cd
+
+
+DRAG = Force("drag", (AtmosphericDrag,), _compile, parameters=lambda components: ["cd"] if components else [],
+             bodies=lambda components, center: ["sun"] if components and center != "sun" else [])

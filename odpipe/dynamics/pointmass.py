@@ -10,8 +10,29 @@ term is absent. Gradients d a / d r are returned for the STM.
 
 from __future__ import annotations
 
+from collections import namedtuple
+from dataclasses import dataclass
+from typing import Sequence
+
 import numpy as np
 from numba import njit
+
+from odpipe.dynamics.registry import Force, kernel
+
+BARYCENTRES = ("ssb", "emb")
+
+
+@dataclass
+class PointMasses:
+    """Third bodies (NAIF names) from the ephemeris, indirect terms included; a body that
+    also has a :class:`~odpipe.dynamics.gravity_fields.SphericalHarmonics` field keeps only
+    its indirect term here."""
+
+    bodies: Sequence[str]
+
+
+CentralData = namedtuple("CentralData", ["gm"])  # m^3/s^2; 0 for a barycentre or a centre with a field
+ThirdBodyData = namedtuple("ThirdBodyData", ["gm", "slot", "direct"])  # (n,) m^3/s^2, env.pos row, bool
 
 
 @njit(cache=True)
@@ -39,3 +60,47 @@ def third_body(r, s, gm, acc, grad):
         acc[i] += kd * d[i] - ks * s[i]
         for j in range(3):
             grad[i, j] += kd * (3.0 * d[i] * d[j] / dn2 - (1.0 if i == j else 0.0))
+
+
+def central_gm(ctx) -> float:
+    """GM (m^3/s^2) of the central body; 0 for a barycentre."""
+    return 0.0 if ctx.center in BARYCENTRES else ctx.gm(ctx.center)
+
+
+def _compile_central(components, ctx) -> CentralData:
+    return CentralData(0.0 if ctx.center in ctx.harmonic_bodies else central_gm(ctx))
+
+
+def _third_bodies(components) -> list[str]:
+    return [b.lower() for pm in components for b in pm.bodies]
+
+
+def _compile_third(components, ctx) -> ThirdBodyData:
+    bodies = _third_bodies(components)
+    rows = ([b for b in bodies if b not in ctx.harmonic_bodies]
+            + [b for b in bodies if b in ctx.harmonic_bodies])
+    return ThirdBodyData(np.array([ctx.gm(b) for b in rows], dtype=float),
+                         np.array([ctx.slot[b] for b in rows], dtype=np.int64),
+                         np.array([b not in ctx.harmonic_bodies for b in rows], dtype=np.bool_))
+
+
+@kernel(CentralData)
+def _central_kernel(data, t, r, v, env, acc, grad_r, grad_v, dadp):
+    if data.gm > 0.0:
+        central(r, data.gm, acc, grad_r)
+
+
+@kernel(ThirdBodyData)
+def _third_kernel(data, t, r, v, env, acc, grad_r, grad_v, dadp):
+    for k in range(data.gm.shape[0]):
+        s = env.pos[data.slot[k]]
+        if data.direct[k]:
+            third_body(r, s, data.gm[k], acc, grad_r)
+        else:  # body carries SH: indirect point-mass term only
+            sn = np.sqrt(np.sum(s * s))
+            acc -= data.gm[k] * s / sn**3
+
+
+CENTRAL = Force("central", (), _compile_central)
+THIRD_BODIES = Force("third_bodies", (PointMasses,), _compile_third,
+                     bodies=lambda components, center: _third_bodies(components))

@@ -28,7 +28,7 @@ class IntegrationError(RuntimeError):
 def _state_derivative(t, r, v, model):
     acc = np.zeros(3)
     acceleration(t, r, v, model, acc, np.zeros((3, 3)), np.zeros((3, 3)),
-                 np.zeros((model[15].shape[0], 3)))
+                 np.zeros((model.n_params, 3)))
     return np.concatenate([v, acc])
 
 
@@ -65,7 +65,7 @@ def propagate(state0, t0: float, t1: float, force_model: ForceModel, with_stm: b
     n_eval = 0
     t_a = t0
     for t_b in cuts + [t1]:
-        model[1][5] = 0.5 * (t_a + t_b)
+        model.segment[0] = 0.5 * (t_a + t_b)
         try:
             ts, ys, Fs, ne = (integrate_rk4(model, float(t_a), y, float(t_b), float(max_step), 6)
                               if method == "rk4" else

@@ -7,10 +7,23 @@ below 1e-10 m/s^2 for cislunar orbits and are not modelled.
 
 from __future__ import annotations
 
+from collections import namedtuple
+from dataclasses import dataclass
+
 import numpy as np
 from numba import njit
 
 from odpipe.constants import C_LIGHT
+from odpipe.dynamics.pointmass import central_gm
+from odpipe.dynamics.registry import Force, kernel
+
+
+@dataclass
+class Relativity:
+    """The Schwarzschild term of the central body."""
+
+
+RelativityData = namedtuple("RelativityData", ["on", "gm"])  # bool; central GM, m^3/s^2
 
 
 @njit(cache=True)
@@ -33,3 +46,16 @@ def schwarzschild(r, v, gm, acc, grad_r, grad_v):
                              + k * (alpha * eye - 4.0 * gm / (rn2 * rn) * r[i] * r[j]
                                     + 4.0 * v[i] * v[j]))
             grad_v[i, j] += k * (-2.0 * r[i] * v[j] + 4.0 * v[i] * r[j] + 4.0 * rv * eye)
+
+
+def _compile(components, ctx) -> RelativityData:
+    return RelativityData(bool(components), central_gm(ctx))
+
+
+@kernel(RelativityData)
+def _kernel(data, t, r, v, env, acc, grad_r, grad_v, dadp):
+    if data.on:
+        schwarzschild(r, v, data.gm, acc, grad_r, grad_v)
+
+
+RELATIVITY = Force("relativity", (Relativity,), _compile)

@@ -20,13 +20,60 @@ with penumbra, multiplied over occulting bodies.
 
 from __future__ import annotations
 
+from collections import namedtuple
+from dataclasses import dataclass
+from typing import Sequence
+
 import numpy as np
 from numba import njit
 
-from odpipe.constants import AU
+from odpipe.constants import AU, EGM96_RADIUS, MOON_RADIUS
+from odpipe.dynamics.registry import Force, kernel
+
 P_SUN_1AU = 4.56e-6  # N/m^2 at 1 AU (Montenbruck & Gill 2000)
 R_SUN = 6.96e8  # m, photospheric radius used for the shadow cones
+BODY_RADIUS = {"earth": EGM96_RADIUS, "moon": MOON_RADIUS}  # m, for shadows
 PLATE, SUN_PLATE, CYLINDER, SUN_CYLINDER = 0, 1, 2, 3
+
+
+@dataclass
+class Plate:
+    """Flat plate: ``normal`` ICRF unit vector or 'sun'; area m^2; reflectivities."""
+
+    normal: object
+    area: float
+    rho_s: float = 0.0
+    rho_d: float = 0.0
+
+
+@dataclass
+class Cylinder:
+    """Cylinder (spin axis ``axis``: ICRF unit vector or 'sun'); radius, length m."""
+
+    axis: object
+    radius: float
+    length: float
+    rho_s: float = 0.0
+    rho_d: float = 0.0
+
+
+@dataclass
+class SolarRadiationPressure:
+    """Cannonball ``cr_area`` (Cr * A, m^2) and/or ``surfaces``; shadows of ``occulters``;
+    pressure ``p_1au`` (N/m^2); ``scale`` the estimable multiplier (parameter 'srp_scale',
+    and 'rho_s[k]', 'rho_d[k]' for surface k)."""
+
+    cr_area: float = 0.0
+    surfaces: Sequence = ()
+    occulters: Sequence[str] = ("earth", "moon")
+    p_1au: float = P_SUN_1AU
+    scale: float = 1.0
+
+
+# surfaces (n, 8) rows as above; occulters' radius (m) and env.pos row (-1: the centre);
+# sun_slot (-1: the Sun is the centre); d a/d p rows of srp_scale and of (rho_s, rho_d) per surface.
+SrpData = namedtuple("SrpData", ["on", "cr_area", "p_1au", "scale", "surfaces", "occ_radius", "occ_slot",
+                                 "sun_slot", "scale_row", "rho_rows"])
 
 
 @njit(cache=True)
@@ -132,3 +179,69 @@ def srp_acceleration(r, r_sun, nu, scale, p_1au, mass, cr_area, surfaces,
             d_rho_d[k, i] += scale * p * dF_dd[k, i]
     # p ~ 1/d^2 and d d/d r = -e^T
     grad_r[:, :] += scale * p * (2.0 / d * np.outer(F, e) + J @ de_dr)
+
+
+def _parameters(components) -> list[str]:
+    names = []
+    for srp in components:
+        names.append("srp_scale")
+        for k in range(len(srp.surfaces)):
+            names += [f"rho_s[{k}]", f"rho_d[{k}]"]
+    return names
+
+
+def _surface_row(sf) -> list[float]:
+    direction = sf.normal if isinstance(sf, Plate) else sf.axis
+    sun = isinstance(direction, str)
+    vec = np.zeros(3) if sun else np.asarray(direction, float)
+    if isinstance(sf, Plate):
+        return [SUN_PLATE if sun else PLATE, *vec, sf.area, 0.0, sf.rho_s, sf.rho_d]
+    return [SUN_CYLINDER if sun else CYLINDER, *vec, sf.radius, sf.length, sf.rho_s, sf.rho_d]
+
+
+def _compile(components, ctx) -> SrpData:
+    if not components:
+        return SrpData(False, 0.0, 0.0, 0.0, np.zeros((0, 8)), np.zeros(0), np.zeros(0, dtype=np.int64), -1,
+                       -1, np.zeros((0, 2), dtype=np.int64))
+    srp = components[0]
+    occ = [b.lower() for b in srp.occulters]
+    ns = len(srp.surfaces)
+    return SrpData(True, float(srp.cr_area), float(srp.p_1au), float(srp.scale),
+                   np.array([_surface_row(sf) for sf in srp.surfaces], dtype=float).reshape(-1, 8),
+                   np.array([BODY_RADIUS[b] for b in occ], dtype=float),
+                   np.array([ctx.slot.get(b, -1) for b in occ], dtype=np.int64),
+                   ctx.slot.get("sun", -1), int(ctx.rows(["srp_scale"])[0]),
+                   ctx.rows([f"rho_{c}[{k}]" for k in range(ns) for c in "sd"]).reshape(ns, 2))
+
+
+def _bodies(components, center) -> list[str]:
+    if not components:
+        return []
+    return [b.lower() for b in components[0].occulters if b.lower() != center] + (["sun"] if center != "sun" else [])
+
+
+@kernel(SrpData)
+def _kernel(data, t, r, v, env, acc, grad_r, grad_v, dadp):
+    if not data.on:
+        return
+    r_sun = env.pos[data.sun_slot] if data.sun_slot >= 0 else np.zeros(3)
+    nu = 1.0
+    for k in range(data.occ_radius.shape[0]):
+        r_b = env.pos[data.occ_slot[k]] if data.occ_slot[k] >= 0 else np.zeros(3)
+        nu *= shadow_factor(r, r_sun, r_b, data.occ_radius[k])
+    ns = data.surfaces.shape[0]
+    d_scale = np.zeros(3)
+    d_rs = np.zeros((ns, 3))
+    d_rd = np.zeros((ns, 3))
+    srp_acceleration(r, r_sun, nu, data.scale, data.p_1au, env.mass, data.cr_area, data.surfaces,
+                     acc, grad_r, d_scale, d_rs, d_rd)
+    if data.scale_row >= 0:
+        dadp[data.scale_row] += d_scale
+    for k in range(ns):
+        if data.rho_rows[k, 0] >= 0:
+            dadp[data.rho_rows[k, 0]] += d_rs[k]
+        if data.rho_rows[k, 1] >= 0:
+            dadp[data.rho_rows[k, 1]] += d_rd[k]
+
+
+SRP = Force("srp", (SolarRadiationPressure,), _compile, parameters=_parameters, bodies=_bodies)

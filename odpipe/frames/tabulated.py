@@ -20,9 +20,9 @@ SEGMENT_S, DEGREE = 3600.0, 12
 
 
 @njit(cache=True)
-def _evaluate_many(coefs, meta, t, out):
+def _evaluate_many(coefs, meta, ch, t, out):
     for i in range(t.size):
-        evaluate(coefs, meta, 0, t[i], out[i])
+        evaluate(coefs, meta, ch, t[i], out[i])
 
 
 class TabulatedRotation:
@@ -36,9 +36,9 @@ class TabulatedRotation:
         self._coefs, self._meta = coef[None], meta[None]
 
     def __call__(self, t) -> np.ndarray:
-        t = np.atleast_1d(np.asarray(t, float))
+        t = np.ascontiguousarray(np.atleast_1d(np.asarray(t, float)))  # one compiled signature
         if t.size and (t.min() < self.t0 or t.max() > self.t1):
             raise ValueError(f"epoch outside the tabulated Earth orientation [{self.t0}, {self.t1}] TDB s")
         out = np.empty((t.size, 9))
-        _evaluate_many(self._coefs, self._meta, t, out)
+        _evaluate_many(self._coefs, self._meta, 0, t, out)  # channel 0 from Python: int64, not a literal
         return out.reshape(-1, 3, 3)
