@@ -21,7 +21,8 @@ import numpy as np
 import pandas as pd
 
 from odpipe.constants import SECONDS_PER_DAY
-from odpipe.dynamics.forces import AtmosphericDrag, ForceModel, SolarRadiationPressure
+from odpipe.dynamics.forces import AtmosphericDrag, ForceModel, InertialPolynomialAcceleration, SolarRadiationPressure
+from odpipe.dynamics.polynomial import PARAMETERS as POLY_PARAMETERS
 from odpipe.estimation.fit import EDIT_INNOVATION, NONFINITE, FitOptions, Observations, Solution, build_grid, fit
 from odpipe.estimation.maneuvers import maneuver_table
 from odpipe.estimation.registry import GaussMarkov, ParameterRegistry
@@ -65,6 +66,8 @@ class ArcSetup:
     ``range_bias_per`` "station": one per station over the arc whatever the passes.
     bias_apriori: a priori bias values (m; rad for angles) by "observable:station_rx" or "observable" (others 0).
     cd_sigma: a priori sigma of the drag coefficient (None: not estimated; a priori the model's Cd).
+    polynomial_sigma: (c0 m/s^2, c1 m/s^3) a priori sigmas of every inertial polynomial acceleration's
+    coefficients (None: fixed; a priori the model's values).
     outward: (epoch TDB s, first half-window s, factor): fit outward from that epoch (:mod:`.outward`).
     oscillator_sigma: (y0, y1 1/s) sigmas of the one-way oscillator's fractional frequency offset and drift,
     when doppler_1way is fitted (a priori and reference epoch from ``measurements.oscillators``).
@@ -94,6 +97,7 @@ class ArcSetup:
     angle_bias_sigma: float | None = None
     bias_apriori: dict = field(default_factory=dict)
     cd_sigma: float | None = None
+    polynomial_sigma: tuple | None = None
     oscillator_sigma: tuple | None = None
     station_sigma: float | None = None
     media_sigma: float | None = None
@@ -198,6 +202,14 @@ def build_registry(setup: ArcSetup, rows: pd.DataFrame) -> ParameterRegistry:
         if not drag:
             raise ValueError("cd_sigma given but the force model has no drag")
         reg.add(f"{sc}.cd", "dynamic", drag[0].cd, setup.cd_sigma, owner=sc, model="cd")
+    if setup.polynomial_sigma is not None:
+        polys = setup.force_model.of_type(InertialPolynomialAcceleration)
+        if not polys:
+            raise ValueError("polynomial_sigma given but the force model has no polynomial acceleration")
+        for k, poly in enumerate(polys):
+            for name, value in zip(POLY_PARAMETERS, (*poly.c0, *poly.c1)):
+                reg.add(f"{sc}.poly[{k}].{name}", "dynamic", float(value), setup.polynomial_sigma[name[-1] == "1"],
+                        owner=sc, model=f"poly[{k}].{name}")
     if setup.stochastic is not None:
         g = setup.stochastic
         reg.add_stochastic_acceleration(sc, g.sigma, g.tau, g.batch)

@@ -197,6 +197,20 @@ class DragSection:
 
 
 @dataclass
+class PolynomialAccelerationSection:
+    """A constant plus a linear drift along the ICRF axes, a = c0 + c1 (t - epoch): e.g. a propellant leak."""
+
+    epoch: str | None = checked(utc_time, default=None)  # UTC ISO reference time (none: initial_state.epoch, else arc.start)
+    c0: list[float] = checked(finite, default_factory=lambda: [0.0, 0.0, 0.0])  # m/s², x y z (the a priori when estimated)
+    c1: list[float] = checked(finite, default_factory=lambda: [0.0, 0.0, 0.0])  # m/s³, x y z (the a priori when estimated)
+
+    def problems(self):
+        for name in ("c0", "c1"):
+            if len(getattr(self, name)) != 3:
+                yield name, "expected 3 components (x, y, z)"
+
+
+@dataclass
 class DynamicsSection:
     center: str  # central body of the integration, e.g. "earth", "moon", "ssb"
     ephemeris: str = "de440"  # 'de440', 'de421' or a .bsp path
@@ -204,6 +218,7 @@ class DynamicsSection:
     gravity: list[GravitySection] = field(default_factory=list)  # spherical-harmonic fields ([[dynamics.gravity]])
     srp: SrpSection | None = None  # solar radiation pressure (none: off)
     drag: DragSection | None = None  # atmospheric drag (none: off)
+    polynomial_acceleration: PolynomialAccelerationSection | None = None  # inertial polynomial acceleration (none: off)
     mass: float = checked(positive, default=1000.0)  # kg
     relativity: bool = False  # the central body's post-Newtonian term
 
@@ -318,6 +333,8 @@ class EstimationSection:
     # its unit, e.g. { angle_az = "0.01 deg" } (the others 0)
     angle_bias_apriori: dict[str, float | str] = checked(_angles, default_factory=dict)
     cd_sigma: float | None = checked(positive, default=None)  # a priori sigma of the drag Cd (none: fixed)
+    # a priori sigmas of the polynomial acceleration's c0 (m/s²) and c1 (m/s³), each axis (none: fixed)
+    polynomial_sigma: list[float] | None = checked(positive, default=None)
     # one-way Doppler's oscillator, estimated when set: sigmas of its fractional frequency offset y0 and drift
     # y1 (1/s) about the arc start, one pair for every band it drives (a priori 0: the rows' reference)
     oscillator_sigma: list[float] | None = checked(positive, default=None)
@@ -378,6 +395,11 @@ class RunConfig:
         est = self.estimation
         if est.cd_sigma is not None and self.dynamics.drag is None:
             yield "estimation.cd_sigma", "needs [dynamics.drag] (no drag to estimate a Cd of)"
+        if est.polynomial_sigma is not None:
+            if self.dynamics.polynomial_acceleration is None:
+                yield "estimation.polynomial_sigma", "needs [dynamics.polynomial_acceleration]"
+            if len(est.polynomial_sigma) != 2:
+                yield "estimation.polynomial_sigma", "expected 2 sigmas: [c0 m/s², c1 m/s³]"
         if est.outward is not None and self.initial_state.epoch is None:
             yield "estimation.outward", "needs initial_state.epoch (the fit grows outward from it)"
         if est.angle_bias_apriori and est.angle_bias_sigma is None:

@@ -47,6 +47,10 @@ def force_model(cfg: RunConfig) -> F.ForceModel:
         comps.append(F.SolarRadiationPressure(dyn.srp.cr_area, surfaces, tuple(dyn.srp.occulters)))
     if dyn.drag is not None:
         comps.append(F.AtmosphericDrag(dyn.drag.cd, dyn.drag.area, dyn.drag.n_bulge))
+    if dyn.polynomial_acceleration is not None:
+        poly = dyn.polynomial_acceleration
+        t_ref = tdb(poly.epoch or cfg.initial_state.epoch or cfg.arc.start)
+        comps.append(F.InertialPolynomialAcceleration(t_ref, tuple(poly.c0), tuple(poly.c1)))
     if dyn.relativity:
         comps.append(F.Relativity())
     return F.ForceModel(dyn.center, comps, dyn.mass, eph)
@@ -144,6 +148,7 @@ def arc_setup(cfg: RunConfig, fm: F.ForceModel, ramps, catalog: StationCatalog) 
                     angle_bias_sigma=None if est.angle_bias_sigma is None
                     else sigma_value("angle_", est.angle_bias_sigma),
                     cd_sigma=est.cd_sigma if cfg.dynamics.drag is not None else None,
+                    polynomial_sigma=tuple(est.polynomial_sigma) if est.polynomial_sigma else None,
                     outward=None if est.outward is None else (t_state, est.outward.first_hours * 3600.0,
                                                                est.outward.factor),
                     oscillator_sigma=None if est.oscillator_sigma is None else tuple(est.oscillator_sigma),

@@ -22,11 +22,13 @@ _GROUPS = {
     "dv": ("mm/s", 1e3, "{:.3f}"),
     "s": ("s", 1.0, "{:.3f}"),
     "m/s2": ("m/s²", 1.0, "{:.4g}"),
+    "m/s3": ("m/s³", 1.0, "{:.4g}"),
     "1/s": ("1/s", 1.0, "{:.4g}"),
     "1": ("1", 1.0, "{:.5f}"),
 }
 _TITLES = {"m": "positions, station coordinates and range biases", "rad": "angle biases", "m/s": "velocities",
-           "dv": "maneuver ΔV components", "s": "maneuver epoch offsets", "m/s2": "stochastic accelerations",
+           "dv": "maneuver ΔV components", "s": "maneuver epoch offsets", "m/s2": "stochastic and polynomial accelerations",
+           "m/s3": "polynomial acceleration drifts",
            "1/s": "frequency drifts", "1": "scale factors and fractional offsets"}
 
 
@@ -46,6 +48,8 @@ def group(name: str, kind: str) -> str:
         return "m/s2"
     if kind == "clock":
         return "1/s" if name.endswith("_y1") else "1"
+    if kind == "dynamic" and ".poly[" in name:
+        return "m/s3" if name.endswith("1") else "m/s2"
     if kind in ("dynamic", "media"):
         return "1"
     raise ValueError(f"parameter {name!r}: no unit known for kind {kind!r}")
@@ -53,7 +57,7 @@ def group(name: str, kind: str) -> str:
 
 def with_units(params: pd.DataFrame) -> pd.DataFrame:
     """The parameter table with a ``unit`` column (SI, as the values are)."""
-    units = {"dv": "m/s", "m/s2": "m/s^2"}
+    units = {"dv": "m/s", "m/s2": "m/s^2", "m/s3": "m/s^3"}
     out = params.copy()
     out.insert(2, "unit", [units.get(g, g) for g in map(group, params["name"], params["kind"])])
     return out
