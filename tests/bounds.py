@@ -46,3 +46,11 @@ def assert_within_covariance(err, cov, alpha: float = ALPHA) -> float:
     assert q < nees_upper(err.size, alpha), (q, nees_upper(err.size, alpha), z)
     assert np.all(np.abs(z) < max_z(err.size, alpha)), z
     return q
+
+
+def rms_bounds(count: int, fitted: int = 0, alpha: float = ALPHA) -> tuple[float, float]:
+    """Bounds of the RMS of ``count`` residuals / sigma when ``fitted`` parameters were fitted to them
+    (chi-square with count - fitted to count degrees of freedom)."""
+    lo = chi2.ppf(alpha / 2, count - fitted) / count
+    hi = chi2.ppf(1.0 - alpha / 2, count) / count
+    return float(np.sqrt(lo)), float(np.sqrt(hi))

@@ -22,6 +22,7 @@ from odpipe.od.arc import build_registry, select_rows
 from odpipe.od.segment import SegmentTrajectory
 from odpipe.dynamics.forces import ForceModel
 from test_od_simulate import (PERIGEE_UTC, PERTURBATION, STATIONS, TRUE_SRP_SCALE, X_PERIGEE, force_model,
+                              truth_force_model,
                               measurement_setup)
 from odpipe.time import utc_to_tdb
 
@@ -33,7 +34,7 @@ DAYS = 2.0
 
 def _fire(x_pre, a, t_fire, t1, dv):
     """State at t1 of a burn ``dv`` fired at ``t_fire``, from the pre-burn state ``x_pre`` at ``a``."""
-    fm = force_model(TRUE_SRP_SCALE)
+    fm = truth_force_model()
     x_f = propagate(x_pre, a, t_fire, fm, with_stm=False).state(t_fire)[0] if t_fire != a else x_pre.copy()
     x_f[3:] += dv
     return propagate(x_f, t_fire, t1, fm, with_stm=False).state(t1)[0]
@@ -44,10 +45,10 @@ def case():
     start_utc = PERIGEE_UTC + np.timedelta64(1, "D")
     t0 = float(utc_to_tdb(start_utc)[()])
     t1 = t0 + DAYS * 86400.0
-    x0 = propagate(X_PERIGEE, float(utc_to_tdb(PERIGEE_UTC)[()]), t0, force_model(TRUE_SRP_SCALE),
+    x0 = propagate(X_PERIGEE, float(utc_to_tdb(PERIGEE_UTC)[()]), t0, truth_force_model(),
                    with_stm=False).state(t0)[0]
     t_man = t0 + 0.8 * 86400.0
-    fm = force_model(TRUE_SRP_SCALE, [ImpulsiveManeuver(t_man + LATE, DV)])
+    fm = truth_force_model([ImpulsiveManeuver(t_man + LATE, DV)])
     x_back = propagate(x0, t0, t0 - 600.0, fm, with_stm=False).state(t0 - 600.0)[0]
     truth = propagate(x_back, t0 - 600.0, t1 + 60.0, fm, with_stm=True, params=[])
     plan = TrackingPlan(STATIONS, start_utc, start_utc + np.timedelta64(int(DAYS * 86400) - 60, "s"),
