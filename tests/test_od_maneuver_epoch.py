@@ -25,6 +25,7 @@ from test_od_simulate import (PERIGEE_UTC, PERTURBATION, STATIONS, TRUE_SRP_SCAL
                               truth_force_model,
                               measurement_setup)
 from odpipe.time import utc_to_tdb
+from bounds import max_z
 
 DV = np.array([0.3, -0.2, 0.3])                  # m/s, |dV| = 0.47 m/s
 DESIGN_ERROR = np.array([0.006, -0.004, 0.005])  # m/s, within the 10 mm/s a priori
@@ -120,12 +121,12 @@ def test_fit_recovers_a_burn_fired_6_s_late_within_3_sigma(case, fitted):
     sol = fitted
     assert sol.converged
     man = sol.maneuvers.iloc[0]
-    assert abs(man["epoch_offset"] - LATE) < 3 * man["epoch_offset_sigma"], (man["epoch_offset"],
+    assert abs(man["epoch_offset"] - LATE) < max_z(10) * man["epoch_offset_sigma"], (man["epoch_offset"],
                                                                               man["epoch_offset_sigma"])
     assert man["epoch_offset_sigma"] < 0.1         # informative (measured 0.014 s), not the 10 s a priori
-    assert np.all(np.abs(man["estimated"] - DV) < 3 * man["sigma"]), (man["estimated"] - DV, man["sigma"])
+    assert np.all(np.abs(man["estimated"] - DV) < max_z(10) * man["sigma"]), (man["estimated"] - DV, man["sigma"])
     err = sol.states[0] - case["x0"]
-    assert np.all(np.abs(err) < 3 * np.sqrt(np.diag(sol.covariances[0]))), err
+    assert np.all(np.abs(err) < max_z(10) * np.sqrt(np.diag(sol.covariances[0]))), err   # 10 with the burn's
     assert 0.9 < sol.history[-1]["postfit_rms"] < 1.1
 
 

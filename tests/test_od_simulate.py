@@ -4,11 +4,8 @@ Scenario: the peers' cislunar HEO (perigee 6878 km, apogee at lunar distance) on
 after its 2003-06-01 perigee, Earth-centred with Moon and Sun point masses, tracked by DSS-14/43/63 above 10 deg: two-way
 X-band Doppler every 60 s (0.1 mm/s) and range every 600 s (1 m, 3 m bias per pass).
 
-Truth and filter differ in SRP: the truth flies a Sun-pointing flat plate (``SAIL``: its own
-area and reflectivities, the plate code path), the filter a cannonball of Cr*A = 6.5 m^2 with
-an estimated scale. At normal incidence the plate's force lies along the Sun line with Cr*A =
-A (1 + rho_s + 2 rho_d / 3) (Montenbruck & Gill 2000, eq. 3.72), so the scale the filter must
-find is ``TRUE_SRP_SCALE`` = 0.93, from that formula and not from the filter's code.
+Truth and filter differ in SRP as in ``heo_case``: the truth flies a Sun-pointing flat plate,
+the filter a cannonball with an estimated scale (truth ``TRUE_SRP_SCALE`` = 0.93).
 """
 
 from __future__ import annotations
@@ -17,21 +14,17 @@ from functools import lru_cache
 
 import numpy as np
 
-from odpipe.dynamics.forces import (EmpiricalRTN, ForceModel, ImpulsiveManeuver, Plate, PointMasses,
-                                    SolarRadiationPressure)
+from heo_case import CR_AREA, EPOCH0, R0, TRUE_SRP_SCALE, TRUTH_SRP, V0  # noqa: F401 (TRUE_SRP_SCALE: for the fits)
+from odpipe.dynamics.forces import EmpiricalRTN, ForceModel, ImpulsiveManeuver, PointMasses, SolarRadiationPressure
 from odpipe.dynamics.propagator import propagate
 from odpipe.measurements import MeasurementSetup, compute
 from odpipe.od import TrackingPlan, simulate_tracking
 from odpipe.time import utc_to_tdb
 from parsers.table import validate
 
-PERIGEE_UTC = np.datetime64("2003-06-01T00:00:00")
-X_PERIGEE = np.array([6252.878075666748, -360.9143112901398, 2842.206999982947,
-                      -0.559937727219993, 10.347539903919273, 2.5458376452827824]) * 1e3
+PERIGEE_UTC = np.datetime64(EPOCH0)
+X_PERIGEE = np.r_[R0, V0]
 STATIONS = ("DSS-14", "DSS-43", "DSS-63")
-CR_AREA = 1.3 * 5.0                              # m^2, the filter's cannonball
-SAIL = Plate("sun", 4.5, rho_s=0.25, rho_d=0.15)   # m^2: the truth's Sun-pointing plate
-TRUE_SRP_SCALE = SAIL.area * (1.0 + SAIL.rho_s + 2.0 * SAIL.rho_d / 3.0) / CR_AREA
 DV_TRUE = np.array([0.03, -0.02, 0.03])          # |dV| = 4.7 cm/s
 PERTURBATION = np.array([1000.0, -800.0, 600.0, 0.01, -0.008, 0.006])   # ~1 km, ~1 cm/s
 
@@ -51,8 +44,7 @@ def force_model(scale=1.0, extra=()) -> ForceModel:
 def truth_force_model(extra=()) -> ForceModel:
     """The truth's model: point masses and the Sun-pointing plate."""
     eph = measurement_setup().ephemeris
-    return ForceModel("earth", [PointMasses(["moon", "sun"]), SolarRadiationPressure(surfaces=[SAIL]), *extra],
-                      mass=500.0, ephemeris=eph)
+    return ForceModel("earth", [PointMasses(["moon", "sun"]), TRUTH_SRP, *extra], mass=500.0, ephemeris=eph)
 
 
 @lru_cache(maxsize=4)
