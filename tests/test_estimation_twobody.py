@@ -68,7 +68,9 @@ def test_fit_converges_and_recovers_truth_within_covariance(case):
     # position known to metres from a 37 km start
     assert np.linalg.norm(d[:3]) < 10.0
     h = sol.history
-    assert h[0]["prefit_rms"] > 1e4 and h[-1]["postfit_rms"] == pytest.approx(1.0, abs=0.1)
+    assert h[0]["prefit_rms"] > 1e4
+    lo, hi = rms_bounds(sol.residuals["flags"].eq(0).sum(), d.size)   # reweighted: each group's RMS near 1
+    assert lo < h[-1]["postfit_rms"] < hi
 
 
 def test_maneuver_recovered_within_3_sigma(case):
