@@ -25,6 +25,8 @@ from odpipe.estimation.fit import FitOptions, fit
 from bounds import nees_mean_bounds, rms_bounds
 from estimation_cases import SRP_LIKE, twobody_case
 
+pytestmark = pytest.mark.slow
+
 N_RUNS = 50
 DAY = 86400.0
 SIGMA_STATE = (1e3, 1e-2)

@@ -10,6 +10,7 @@ chi-square bounds -- the covariance is the spread of the errors.
 """
 
 import numpy as np
+import pytest
 from scipy.stats import chi2
 
 from bounds import nees_mean_bounds
@@ -17,6 +18,8 @@ from bounds import nees_mean_bounds
 from odpipe.estimation.fit import FitOptions, Observations, fit
 from odpipe.estimation.registry import ParameterRegistry
 from estimation_cases import LinearProblem
+
+pytestmark = pytest.mark.slow
 
 TAU, SIG_A, BATCH = 7200.0, 2e-7, 1800.0
 ARC, DT_OBS = 2 * 86400.0, 300.0

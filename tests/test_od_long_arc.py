@@ -20,6 +20,8 @@ from odpipe.od import fit_arc
 from bounds import max_z, nees, nees_mean_bounds, nees_upper, rms_bounds
 from libration_case import libration_arc
 
+pytestmark = pytest.mark.slow
+
 
 @pytest.fixture(scope="module")
 def fitted():

@@ -1,8 +1,9 @@
 """Simulated truth for the OD tests (shared scenario builders) and checks of the simulator itself.
 
 Scenario: the peers' cislunar HEO (perigee 6878 km, apogee at lunar distance) one day
-after its 2003-06-01 perigee, Earth-centred with Moon and Sun point masses, tracked by DSS-14/43/63 above 10 deg: two-way
-X-band Doppler every 60 s (0.1 mm/s) and range every 600 s (1 m, 3 m bias per pass).
+after its 2003-06-01 perigee, Earth-centred with Moon and Sun point masses, tracked by
+DSS-14/43/63 above 10 deg: two-way X-band Doppler every 60 s (0.1 mm/s) and range every
+600 s (1 m, 3 m bias per pass).
 
 Truth and filter differ in SRP as in ``heo_case``: the truth flies a Sun-pointing flat plate,
 the filter a cannonball with an estimated scale (truth ``TRUE_SRP_SCALE`` = 0.93).
