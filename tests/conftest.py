@@ -3,6 +3,10 @@
 Real data live in ``../shared/data`` beside the project (``ODPIPE_SHARED_DATA``
 overrides). Outside CI, tests marked ``realdata`` skip with a message when the
 folder is absent; under ``CI=true`` its absence is a failure.
+
+Files holding a test marked ``slow`` run first, whole and in their own order, so that
+``make test``'s workers (pytest-xdist, whole files per worker) start the long ones early and
+finish together.
 """
 
 from __future__ import annotations
@@ -25,6 +29,8 @@ def pytest_collection_modifyitems(config, items):
     for item in items:
         if "realdata" in item.keywords:
             item.add_marker(pytest.mark.usefixtures("shared_data"))
+    slow_files = {item.path for item in items if "slow" in item.keywords}
+    items.sort(key=lambda item: item.path not in slow_files)   # stable: each file stays in one piece
 
 
 @pytest.fixture(scope="session")

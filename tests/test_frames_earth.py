@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
+import spiceypy as sp
 
 from odpipe.environment.eop import ARCSEC, EOPValues, eop_at
 from odpipe.environment.stations import StationCatalog
@@ -68,7 +69,6 @@ def test_rotation_velocity_equals_finite_difference_and_state_round_trips():
 
 @pytest.mark.realdata
 def test_dss14_gcrs_position_agrees_with_spice(shared_data):
-    sp = pytest.importorskip("spiceypy")
     k = shared_data / "kernels"
     kernels = [str(k / n) for n in ("naif0012.tls", "earth_000101_190127_181105.bpc", "earthstns_itrf93_201023.bsp")]
     for path in kernels:

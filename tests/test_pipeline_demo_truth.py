@@ -14,6 +14,8 @@ from odpipe.simulate.case import load
 from odpipe.simulate.run import run_case
 from odpipe.time import utc_to_tdb
 
+pytestmark = pytest.mark.slow
+
 DAYS = 8.0      # one station-keeping burn (day 3.5), two DSN passes at each complex, Berkeley and USN passes
 
 

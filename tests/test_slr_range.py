@@ -113,6 +113,7 @@ def test_centre_of_mass_offset_shortens_the_range(lageos):
 
 
 
+@pytest.mark.slow
 @pytest.mark.realdata
 def test_lageos2_fit_lands_within_a_metre_of_orekits_reference_state(shared_data, lageos):
     """LAGEOS-2's 95 normal points fitted from Orekit's a priori (od_test_Lageos2.in: EME2000 state at

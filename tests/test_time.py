@@ -6,6 +6,7 @@ from __future__ import annotations
 import erfa
 import numpy as np
 import pytest
+import spiceypy as sp
 
 import odpipe.time as T
 
@@ -63,7 +64,6 @@ def test_tdb_minus_tt_equals_erfa_dtdb_with_station_terms():
 
 @pytest.mark.realdata
 def test_utc_to_tdb_agrees_with_spice(shared_data):
-    sp = pytest.importorskip("spiceypy")
     lsk = str(shared_data / "kernels" / "naif0012.tls")
     sp.furnsh(lsk)
     try:
