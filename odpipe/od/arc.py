@@ -216,7 +216,48 @@ def build_registry(setup: ArcSetup, rows: pd.DataFrame) -> ParameterRegistry:
     return reg
 
 
-def fit_arc(table: pd.DataFrame, setup: ArcSetup) -> ArcSolution:
+class ReferenceChain:
+    """One spacecraft's reference over ``[t0, t1]`` (TDB s) from consecutive segments: ``state(t)`` (N, 6)
+    m, m/s, from the segment whose span holds ``t`` (before ``t0``: the first one's look-back);
+    ``n_eval`` force evaluations."""
+
+    def __init__(self, starts, trajectories, t0: float, t1: float):
+        self.starts, self.trajectories = np.asarray(starts, float), list(trajectories)
+        self.t0, self.t1 = float(t0), float(t1)
+        self.n_eval = sum(tr.n_eval for tr in self.trajectories)
+
+    def state(self, t) -> np.ndarray:
+        t = np.atleast_1d(np.asarray(t, float))
+        k = np.clip(np.searchsorted(self.starts, t, "right") - 1, 0, len(self.trajectories) - 1)
+        out = np.empty((t.size, 6))
+        for j in np.unique(k):
+            out[k == j] = self.trajectories[j].state(t[k == j])
+        return out
+
+
+def a_priori_reference(setup: ArcSetup, shared: dict) -> ReferenceChain:
+    """The a priori reference over the arc (every parameter at its a priori value, designed maneuvers
+    applied: at a maneuver epoch the state after the burn), integrated segment by segment as the fit's
+    first pass flies it, into ``shared``: ``fit_arc(..., shared=shared)`` then starts from these
+    integrations instead of integrating again. For the geometry of the rows before they are edited."""
+    reg = build_registry(setup, pd.DataFrame(columns=["observable", "unit", "station_rx", "station_tx",
+                                                      "pass_id"]))
+    grid, _ = build_grid(reg, setup.start, setup.end, setup.block)
+    problem = TrackingProblem(reg, pd.DataFrame(), np.zeros(0), {setup.spacecraft: setup.force_model},
+                              setup.measurements, setup.start, setup.end, setup.lookback, epochs=grid,
+                              shared=shared)
+    starts, trajs = [], []
+    t, x = setup.start, reg.apriori
+    while t < setup.end:
+        seg = problem.segment(t, x)
+        starts.append(seg.a)
+        trajs.append(seg.trajs[setup.spacecraft])
+        x, _ = problem.transition(t, seg.b, x)
+        t = seg.b
+    return ReferenceChain(starts, trajs, setup.start, setup.end)
+
+
+def fit_arc(table: pd.DataFrame, setup: ArcSetup, shared: dict | None = None) -> ArcSolution:
     """Fit the arc; see :class:`ArcSetup` and :class:`ArcSolution`.
 
     Residual table columns: row (index in ``table``), epoch, observable, station_rx, pass_id,
@@ -224,6 +265,7 @@ def fit_arc(table: pd.DataFrame, setup: ArcSetup) -> ArcSolution:
     priori reference: the first iteration's pre-fit residual, row units), prefit/postfit (row units,
     last iteration), to_los (m or m/s per unit), apriori_los/prefit_los/postfit_los, sigma (row units, after reweighting), flags (Flag.RESIDUAL when
     edited by the fit), status (why a row could not be computed; such rows are not fitted).
+    ``shared``: reference segments already integrated for this arc (:func:`a_priori_reference`).
     """
     rows, times = select_rows(table, setup)
     reg = build_registry(setup, rows)
@@ -236,9 +278,11 @@ def fit_arc(table: pd.DataFrame, setup: ArcSetup) -> ArcSolution:
         span = (setup.start - setup.lookback - 3600.0, setup.end + 3600.0)
         meas = spanning(meas, *span)
 
+    shared = {} if shared is None else shared
+
     def problem_for(r, t):
         return TrackingProblem(reg, r, t, {setup.spacecraft: setup.force_model}, meas,
-                               setup.start, setup.end, setup.lookback, epochs=grid)
+                               setup.start, setup.end, setup.lookback, epochs=grid, shared=shared)
 
     problem = problem_for(rows, times)
     computed, to_los, status = problem.reference(reg.apriori)

@@ -87,12 +87,15 @@ class TrackingProblem:
     epochs: where transitions will be asked (the filter grid), evaluated per segment in one pass;
     integrator: spacecraft id -> :func:`propagate` settings overriding ``rtol``/``atol`` (fixed steps
     as an onboard filter takes them: ``{"rtol": inf, "max_step": 60}``, or ``{"method": "rk4",
-    "max_step": 60}``).
+    "max_step": 60}``);
+    shared: a dict shared by problems of one arc (e.g. the geometry step's a priori reference and the
+    fit's problems): a segment integrated by one from the same start state, parameter values and
+    settings is taken from it instead of integrated again (the latest per spacecraft and span is kept).
     """
 
     def __init__(self, registry, rows: pd.DataFrame, times: np.ndarray, force_models: dict,
                  setup: MeasurementSetup, t_start: float, t_end: float, lookback: float = 120.0,
-                 rtol: float = 1e-12, atol: float = 1e-6, epochs=(), integrator=None):
+                 rtol: float = 1e-12, atol: float = 1e-6, epochs=(), integrator=None, shared=None):
         self.registry = registry
         self.rows = rows.reset_index(drop=True)
         self.times = np.asarray(times, float)
@@ -104,6 +107,7 @@ class TrackingProblem:
         self.integrator = dict(integrator or {})
         self.epochs = np.asarray(epochs, float)
         self.n_propagations = 0
+        self.shared = {} if shared is None else shared
         self._segments: list[_Segment] = []
         self._last = (None, None)   # (segment, x1) of the last transition, to skip re-checks
         params = registry.parameters
@@ -203,11 +207,41 @@ class TrackingProblem:
             dv = x0[dv_idx] if dv_idx is not None else None
             dt = x0[dt_idx] if dt_idx is not None else None
             settings = {"rtol": self.rtol, "atol": self.atol, **self.integrator.get(sc, {})}
-            trajs[sc] = SegmentTrajectory(x0[ix["state"]], a, b, fm, names, dv, self.lookback, dt=dt, **settings)
-            trajs[sc].preload(self.epochs[(self.epochs > a) & (self.epochs <= b)])
             pidx[sc] = np.array(idx + (dv_idx or []) + ([dt_idx] if dt_idx is not None else []), int)
-            self.n_propagations += 1
+            key = (x0[ix["state"]].tobytes(), x0[pidx[sc]].tobytes(), tuple(names),
+                   tuple(self.registry.names[i] for i in pidx[sc]), id(self.force_models[sc]), self.lookback,
+                   repr(sorted(settings.items())))
+            held = self.shared.get((sc, a, b))
+            if held is not None and held[0] == key:
+                trajs[sc] = held[1]
+            else:
+                trajs[sc] = SegmentTrajectory(x0[ix["state"]], a, b, fm, names, dv, self.lookback, dt=dt, **settings)
+                self.shared[(sc, a, b)] = (key, trajs[sc])
+                self.n_propagations += 1
+            trajs[sc].preload(self.epochs[(self.epochs > a) & (self.epochs <= b)])
         return b, trajs, pidx
+
+    def linearized(self, a: float, x_a: np.ndarray) -> tuple[float, dict] | None:
+        """(segment end b, sc -> ``states(t)`` (N, 6)) of the trajectory through ``x_a`` at ``a``, to first
+        order about the reference segment held from ``a`` (``x_ref(t) + stm(t) dx(a-) + S(t) dp``), without
+        integrating; None when no held segment starts at ``a``. The error is second order in the difference:
+        for a converged fit's last correction (the smoothed solution against the last reference) it is
+        negligible, which is what products use it for."""
+        seg = next((s for s in self._segments if s.a == a), None)
+        if seg is None:
+            return None
+        x_a = np.asarray(x_a, float)
+        ref = np.zeros(x_a.size)
+        ref[self._key_idx] = seg.key
+        out = {}
+        for sc, traj in seg.trajs.items():
+            dx = x_a[self._sc[sc]["state"]] - traj.x_start
+            dp = x_a[seg.pidx[sc]] - ref[seg.pidx[sc]]
+
+            def states(t, traj=traj, dx=dx, dp=dp):
+                return traj.state(t) + traj.stm(t) @ dx + traj.sensitivity(t) @ dp
+            out[sc] = states
+        return seg.b, out
 
     def _build(self, a, x0) -> _Segment:
         b, trajs, pidx = self.trajectories(a, x0)
