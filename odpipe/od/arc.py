@@ -46,6 +46,10 @@ class ManeuverPlan:
 
 
 DATA_SIGMA = {"range": 2.0, "doppler_2way": 1e-4}  # default data sigmas along the line of sight: m, m/s
+# references of the loose-weight stages (TrackingProblem.set_coarse): over 1 h of GRAIL-B's 55-km lunar orbit
+# (degree 150) 2.4 cm and 3.3e-5 m/s from the exact settings' (rtol 1e-12, atol 1e-6) with 0.61 of their
+# force evaluations (benchmarks/profile_grail_arc.py)
+COARSE_INTEGRATION = {"rtol": 1e-9, "atol": 1e-5}
 
 
 @dataclass
@@ -70,6 +74,8 @@ class ArcSetup:
     block: filter grid spacing (s); lookback: s of trajectory kept before each segment start.
     tabulate_earth_rotation: evaluate the GCRS->ITRS matrix from a per-arc Chebyshev table
     (:mod:`.rotation`, < 1e-12 rad) instead of the full model at every event.
+    coarse_integration: integrator settings of the references of the fit's loose-weight stages
+    (all ``sigma_scale`` stages but the last; None: exact throughout).
     """
 
     spacecraft: str
@@ -97,6 +103,7 @@ class ArcSetup:
     lookback: float = 120.0
     growing_days: float | None = 2.0  # first span of the growing-arc start (None: fit the whole arc at once)
     tabulate_earth_rotation: bool = True
+    coarse_integration: dict | None = field(default_factory=lambda: dict(COARSE_INTEGRATION))
 
 
 @dataclass
@@ -218,11 +225,12 @@ def build_registry(setup: ArcSetup, rows: pd.DataFrame) -> ParameterRegistry:
 
 class ReferenceChain:
     """One spacecraft's reference over ``[t0, t1]`` (TDB s) from consecutive segments: ``state(t)`` (N, 6)
-    m, m/s, from the segment whose span holds ``t`` (before ``t0``: the first one's look-back);
-    ``n_eval`` force evaluations."""
+    m, m/s relative to ``center``, from the segment whose span holds ``t`` (before ``t0``: the first
+    one's look-back); ``n_eval`` force evaluations."""
 
     def __init__(self, starts, trajectories, t0: float, t1: float):
         self.starts, self.trajectories = np.asarray(starts, float), list(trajectories)
+        self.center = self.trajectories[0].center
         self.t0, self.t1 = float(t0), float(t1)
         self.n_eval = sum(tr.n_eval for tr in self.trajectories)
 
@@ -245,7 +253,8 @@ def a_priori_reference(setup: ArcSetup, shared: dict) -> ReferenceChain:
     grid, _ = build_grid(reg, setup.start, setup.end, setup.block)
     problem = TrackingProblem(reg, pd.DataFrame(), np.zeros(0), {setup.spacecraft: setup.force_model},
                               setup.measurements, setup.start, setup.end, setup.lookback, epochs=grid,
-                              shared=shared)
+                              shared=shared, coarse=setup.coarse_integration)
+    problem.set_coarse(len(setup.sigma_scale) > 1)   # as the fit flies its first pass
     starts, trajs = [], []
     t, x = setup.start, reg.apriori
     while t < setup.end:
@@ -281,8 +290,10 @@ def fit_arc(table: pd.DataFrame, setup: ArcSetup, shared: dict | None = None) ->
     shared = {} if shared is None else shared
 
     def problem_for(r, t):
-        return TrackingProblem(reg, r, t, {setup.spacecraft: setup.force_model}, meas,
-                               setup.start, setup.end, setup.lookback, epochs=grid, shared=shared)
+        prob = TrackingProblem(reg, r, t, {setup.spacecraft: setup.force_model}, meas, setup.start, setup.end,
+                               setup.lookback, epochs=grid, shared=shared, coarse=setup.coarse_integration)
+        prob.set_coarse(len(options.sigma_scale) > 1)   # as the fit flies its first pass
+        return prob
 
     problem = problem_for(rows, times)
     computed, to_los, status = problem.reference(reg.apriori)
