@@ -153,17 +153,17 @@ def main(argv=None) -> int:
     args = ap.parse_args(argv)
     sampler = Sampler(threading.get_ident(), args.interval)
     sampler.start()
-    t0 = time.perf_counter()
+    t0, c0 = time.perf_counter(), time.process_time()
     try:
         with compile_timer() as ct, Integrations() as integ:
             summary = run_config(args.config, force=True, progress=None)
     except ConfigError as exc:
         print(exc)
         return 1
-    wall = time.perf_counter() - t0
+    wall, cpu = time.perf_counter() - t0, time.process_time() - c0
     sampler.stop.set()
     sampler.join()
-    print(f"{args.config.name}: {wall:.1f} s wall, of which numba compiled {ct.functions} functions in "
+    print(f"{args.config.name}: {wall:.1f} s wall ({cpu:.1f} s CPU of this process), of which numba compiled {ct.functions} functions in "
           f"{ct.seconds:.1f} s; fit {summary.get('fit_seconds', float('nan')):.1f} s")
     total = sum(sampler.by_stage.values())
     print(f"\n{'stage':26s} {'s':>7s} {'share':>6s}")
