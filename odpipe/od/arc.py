@@ -48,7 +48,7 @@ class ManeuverPlan:
 DATA_SIGMA = {"range": 2.0, "doppler_2way": 1e-4}  # default data sigmas along the line of sight: m, m/s
 # references of the loose-weight stages (TrackingProblem.set_coarse): over 1 h of GRAIL-B's 55-km lunar orbit
 # (degree 150) 2.4 cm and 3.3e-5 m/s from the exact settings' (rtol 1e-12, atol 1e-6) with 0.61 of their
-# force evaluations (benchmarks/profile_grail_arc.py)
+# force evaluations (benchmarks/profile_coarse_reference.py)
 COARSE_INTEGRATION = {"rtol": 1e-9, "atol": 1e-5}
 
 
