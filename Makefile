@@ -10,6 +10,7 @@ $(STAMP): pyproject.toml
 	test -x $(BIN)/python || $(PY) -m venv $(VENV)
 	$(BIN)/python -m pip install --quiet --upgrade pip
 	$(BIN)/python -m pip install --quiet -e '.[test]'
+	$(BIN)/python -m odpipe.pipeline.warmup  # numba's on-disk cache, filled once per checkout
 	touch $(STAMP)
 
 demo: $(STAMP)

@@ -14,7 +14,7 @@ interval's wall time goes to the innermost frame that belongs to a stage:
     light time      odpipe/measurements/ (light-time solution, observables and their partials)
     filter          odpipe/estimation/ and odpipe/od/ outside the two above
     smoother        odpipe/estimation/smoother.py
-    products        odpipe/products/, odpipe/runs/, odpipe/pipeline/products.py, run.py:_products
+    products        odpipe/products/, odpipe/operations/, odpipe/pipeline/fitted_trajectory.py, run.py:_products
     set-up          the rest of odpipe/pipeline (force model, a priori trajectory, geometry)
 
 Frames of odpipe/frames, odpipe/time, odpipe/environment, numpy, scipy and pandas are
@@ -22,7 +22,9 @@ passed over (they count for the stage that called them). numba kernels hold the 
 a sample lands just after the kernel returns, in the frame that called it: stages are
 right to the length of one kernel call. Time inside ``odpipe.estimation.fit.fit`` is
 also split by (fit call, iteration, weight stage). numba compilation (none when its
-cache is warm: run twice) is reported apart. Figures are printed, never asserted.
+cache is warm: run twice) is reported apart. Integrations and force-model evaluations
+(``Trajectory.n_eval``, independent of the machine's load) are counted by where
+``propagate`` was called from. Figures are printed, never asserted.
 """
 
 from __future__ import annotations
@@ -39,7 +41,7 @@ sys.path.insert(0, str(ROOT))
 
 from odpipe.dynamics.compile_timer import compile_timer  # noqa: E402
 from odpipe.pipeline.run import run_config  # noqa: E402
-from odpipe.runs.schema import ConfigError  # noqa: E402
+from odpipe.operations.schema import ConfigError  # noqa: E402
 
 STAGES = [  # (path fragment, stage): the first fragment found in a frame's file name wins
     ("/parsers/", "ingest"), ("/odpipe/pipeline/ingest.py", "ingest"),
@@ -49,7 +51,8 @@ STAGES = [  # (path fragment, stage): the first fragment found in a frame's file
     ("/odpipe/measurements/", "light time and partials"),
     ("/odpipe/estimation/smoother.py", "smoother"),
     ("/odpipe/estimation/", "filter"), ("/odpipe/od/", "filter"),
-    ("/odpipe/products/", "products"), ("/odpipe/runs/", "products"), ("/odpipe/pipeline/products.py", "products"),
+    ("/odpipe/products/", "products"), ("/odpipe/operations/", "products"),
+    ("/odpipe/pipeline/fitted_trajectory.py", "products"),
     ("/odpipe/pipeline/", "set-up"),
 ]
 ORDER = ["ingest", "set-up", "media", "compression", "editing", "integration", "light time and partials",
@@ -106,6 +109,43 @@ class Sampler(threading.Thread):
                 self.by_fit[pos][stage] += dt
 
 
+class Integrations:
+    """Wraps ``propagate`` where the pipeline calls it: (integrations, force evaluations) by caller."""
+
+    MODULES = ("odpipe.od.segment", "odpipe.pipeline.setup")
+
+    def __init__(self):
+        self.count = defaultdict(lambda: [0, 0])
+        self.fit_calls: dict = {}
+
+    def __enter__(self):
+        import importlib
+        self.saved = [(importlib.import_module(m), importlib.import_module(m).propagate) for m in self.MODULES]
+        for mod, original in self.saved:
+            mod.propagate = self._wrap(original)
+        return self
+
+    def __exit__(self, *exc):
+        for mod, original in self.saved:
+            mod.propagate = original
+
+    def _wrap(self, original):
+        def counted(*args, **kw):
+            traj = original(*args, **kw)
+            frame = sys._getframe(1)
+            pos = fit_position(frame, self.fit_calls)
+            key = f"fit {pos[0]} iteration {pos[1]}" if pos else stage_of(frame)
+            while frame is not None and pos is None:
+                if frame.f_code.co_name in ("fitted_segments", "reference", "a_priori_reference"):
+                    key = frame.f_code.co_name
+                    break
+                frame = frame.f_back
+            self.count[key][0] += 1
+            self.count[key][1] += traj.n_eval
+            return traj
+        return counted
+
+
 def main(argv=None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("config", nargs="?", type=Path, default=ROOT / "runs" / "grail_b_2012_04_10.toml")
@@ -113,17 +153,17 @@ def main(argv=None) -> int:
     args = ap.parse_args(argv)
     sampler = Sampler(threading.get_ident(), args.interval)
     sampler.start()
-    t0 = time.perf_counter()
+    t0, c0 = time.perf_counter(), time.process_time()
     try:
-        with compile_timer() as ct:
+        with compile_timer() as ct, Integrations() as integ:
             summary = run_config(args.config, force=True, progress=None)
     except ConfigError as exc:
         print(exc)
         return 1
-    wall = time.perf_counter() - t0
+    wall, cpu = time.perf_counter() - t0, time.process_time() - c0
     sampler.stop.set()
     sampler.join()
-    print(f"{args.config.name}: {wall:.1f} s wall, of which numba compiled {ct.functions} functions in "
+    print(f"{args.config.name}: {wall:.1f} s wall ({cpu:.1f} s CPU of this process), of which numba compiled {ct.functions} functions in "
           f"{ct.seconds:.1f} s; fit {summary.get('fit_seconds', float('nan')):.1f} s")
     total = sum(sampler.by_stage.values())
     print(f"\n{'stage':26s} {'s':>7s} {'share':>6s}")
@@ -138,6 +178,11 @@ def main(argv=None) -> int:
                                                                                  for x in kv[0])):
         print(f"{call:8d} {it if it is not None else '-':>4} {st if st is not None else '-':>7} "
               f"{sum(v.values()):7.2f} " + " ".join(f"{v.get(c, 0.0):12.2f}" for c in cols))
+    print(f"\n{'integrations called from':30s} {'calls':>6s} {'force evaluations':>18s}")
+    for key, (calls, evals) in integ.count.items():
+        print(f"{key:30s} {calls:6d} {evals:18d}")
+    print(f"{'total':30s} {sum(c for c, _ in integ.count.values()):6d} "
+          f"{sum(e for _, e in integ.count.values()):18d}")
     return 0
 
 

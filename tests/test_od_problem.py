@@ -14,7 +14,7 @@ import pytest
 
 from odpipe.dynamics.propagator import propagate
 from odpipe.od import ArcSetup, ManeuverPlan, TrackingProblem
-from odpipe.od.arc import build_registry, select_rows
+from odpipe.od.arc import a_priori_reference, build_registry, select_rows
 from test_od_simulate import force_model, measurement_setup, scenario
 
 STEPS = np.array([100.0, 100.0, 100.0, 0.01, 0.01, 0.01])    # m, m/s: well above the integration noise
@@ -123,3 +123,46 @@ def test_integrator_settings_per_spacecraft(case):
     adaptive = propagate(x[:6], sc["t0"], t1, force_model(), with_stm=False).state(t1)[0]
     print("RK4 - adaptive (m)", x1[:3] - adaptive[:3])
     assert np.max(np.abs(x1[:3] - adaptive[:3])) > 1e-6       # another integrator, above round-off
+
+
+def test_linearized_states_match_a_fresh_integration_to_second_order(case):
+    """Products of a converged fit read the last reference corrected to first order (``linearized``):
+    against the segment integrated from the corrected start (state, SRP scale and dV), what the
+    first-order model leaves is below 1e-4 of the correction's own effect (it is second order)."""
+    sc, reg, prob, x_man = case["sc"], case["reg"], case["prob"], case["x_man"]
+    t_man = sc["t_man"]
+    prob.segment(t_man, x_man)
+    x = x_man.copy()
+    x[:6] += [30.0, -20.0, 10.0, 3e-3, -2e-3, 1e-3]
+    x[reg.index("SC.srp_scale")] += 0.02
+    x[reg.indices("maneuver")] += [1e-4, -1e-4, 2e-4]
+    b, near = prob.linearized(t_man, x)
+    end, trajs, _ = prob.trajectories(t_man, x)
+    assert b == end
+    t = np.linspace(t_man - 100.0, b, 50)
+    exact, first = trajs["SC"].state(t), near["SC"](t)
+    effect = np.max(np.abs(exact[:, :3] - prob.linearized(t_man, x_man)[1]["SC"](t)[:, :3]))
+    print(f"first-order model: {np.max(np.abs(first[:, :3] - exact[:, :3])):.2e} m of a {effect:.1f} m change")
+    assert effect > 10.0
+    assert np.max(np.abs(first[:, :3] - exact[:, :3])) < 1e-4 * effect
+    assert prob.linearized(t_man + 1.0, x) is None          # no held segment starts there
+
+
+def test_a_priori_reference_is_the_fits_first_reference(case):
+    """The geometry step's a priori reference (``a_priori_reference``) flies the arc as one integration
+    does (to 1 mm over two days, restarting at the maneuver), and a problem sharing its segments
+    evaluates the a priori reference without integrating again."""
+    sc, reg, setup, rows, times = case["sc"], case["reg"], case["setup"], case["rows"], case["times"]
+    shared = {}
+    chain = a_priori_reference(setup, shared)
+    t = np.linspace(sc["t0"], sc["t1"], 200)
+    direct = propagate(setup.state0, sc["t0"], sc["t1"], force_model(), with_stm=False).state(t)
+    assert np.max(np.abs(chain.state(t)[:, :3] - direct[:, :3])) < 1e-3
+    prob = TrackingProblem(reg, rows, times, {"SC": setup.force_model}, setup.measurements, sc["t0"], sc["t1"],
+                           shared=shared)
+    prob.reference(reg.apriori)
+    assert prob.n_propagations == 0 and len(shared) == 2
+    moved = reg.apriori.copy()
+    moved[0] += 1.0
+    prob.reference(moved)
+    assert prob.n_propagations == 2                     # another reference: integrated

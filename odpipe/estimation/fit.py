@@ -9,6 +9,10 @@ registry coordinates (the full parameter vector, state and parameters alike):
   ``t0`` is applied at the start of the interval.
 * ``predict(t0, x0, rows) -> (computed, H)``: computed values of observation
   rows (all with ``t0 <= t < t1``) and their partials w.r.t. the vector at ``t0``.
+* optionally ``set_coarse(on)``: the fit turns it on for the passes of its loose-weight
+  stages (all but the last ``sigma_scale``), whose references need not be exact (they
+  only bring the reference near the solution), and off for the last stage and once the
+  iterations end.
 
 The grid holds the arc ends, a regular spacing (``block`` s), the batch
 boundaries of every stochastic parameter and any extra epochs (maneuvers). At a
@@ -249,7 +253,9 @@ def fit(problem: Problem, obs: Observations, t_start: float, t_end: float,
     history, prev_rms, converged = [], None, False
     stage, last_stage = 0, len(options.sigma_scale) - 1
     last_step, halvings, stage_start = None, 0, False
+    coarse = getattr(problem, "set_coarse", lambda on: None)
     for it in range(options.max_iter):
+        coarse(stage < last_stage)
         sig_row = obs.sigma * np.array([scale[g] for g in obs.group]) * options.sigma_scale[stage]
         kk = np.inf if stage_start else _edit_k(options, it, prev_rms)  # a new stage's first pass edits nothing
         stage_start = False
@@ -319,6 +325,7 @@ def fit(problem: Problem, obs: Observations, t_start: float, t_end: float,
         if corr < options.tol_dx and rms_ok and it >= 1:
             converged = True
             break
+    coarse(False)
 
     best = min(h["postfit_rms"] for h in history)
     if not converged and not rms <= max(options.diverged_rms, best):  # NaN: everything edited

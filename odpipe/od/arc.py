@@ -48,6 +48,10 @@ class ManeuverPlan:
 
 
 DATA_SIGMA = {"range": 2.0, "doppler_2way": 1e-4}  # default data sigmas along the line of sight: m, m/s
+# references of the loose-weight stages (TrackingProblem.set_coarse): over 1 h of GRAIL-B's 55-km lunar orbit
+# (degree 150) 2.4 cm and 3.3e-5 m/s from the exact settings' (rtol 1e-12, atol 1e-6) with 0.61 of their
+# force evaluations (benchmarks/profile_coarse_reference.py)
+COARSE_INTEGRATION = {"rtol": 1e-9, "atol": 1e-5}
 
 
 @dataclass
@@ -78,6 +82,8 @@ class ArcSetup:
     block: filter grid spacing (s); lookback: s of trajectory kept before each segment start.
     tabulate_earth_rotation: evaluate the GCRS->ITRS matrix from a per-arc Chebyshev table
     (:mod:`.rotation`, < 1e-12 rad) instead of the full model at every event.
+    coarse_integration: integrator settings of the references of the fit's loose-weight stages
+    (all ``sigma_scale`` stages but the last; None: exact throughout).
     """
 
     spacecraft: str
@@ -110,6 +116,7 @@ class ArcSetup:
     growing_days: float | None = 2.0  # first span of the growing-arc start (None: fit the whole arc at once)
     tabulate_earth_rotation: bool = True
     outward: tuple | None = None
+    coarse_integration: dict | None = field(default_factory=lambda: dict(COARSE_INTEGRATION))
 
 
 @dataclass
@@ -250,7 +257,50 @@ def _bias_apriori(setup: ArcSetup, observable: str, station) -> float:
     return float(a.get(f"{observable}:{station}", a.get(observable, 0.0)))
 
 
-def fit_arc(table: pd.DataFrame, setup: ArcSetup) -> ArcSolution:
+class ReferenceChain:
+    """One spacecraft's reference over ``[t0, t1]`` (TDB s) from consecutive segments: ``state(t)`` (N, 6)
+    m, m/s relative to ``center``, from the segment whose span holds ``t`` (before ``t0``: the first
+    one's look-back); ``n_eval`` force evaluations."""
+
+    def __init__(self, starts, trajectories, t0: float, t1: float):
+        self.starts, self.trajectories = np.asarray(starts, float), list(trajectories)
+        self.center = self.trajectories[0].center
+        self.t0, self.t1 = float(t0), float(t1)
+        self.n_eval = sum(tr.n_eval for tr in self.trajectories)
+
+    def state(self, t) -> np.ndarray:
+        t = np.atleast_1d(np.asarray(t, float))
+        k = np.clip(np.searchsorted(self.starts, t, "right") - 1, 0, len(self.trajectories) - 1)
+        out = np.empty((t.size, 6))
+        for j in np.unique(k):
+            out[k == j] = self.trajectories[j].state(t[k == j])
+        return out
+
+
+def a_priori_reference(setup: ArcSetup, shared: dict) -> ReferenceChain:
+    """The a priori reference over the arc (every parameter at its a priori value, designed maneuvers
+    applied: at a maneuver epoch the state after the burn), integrated segment by segment as the fit's
+    first pass flies it, into ``shared``: ``fit_arc(..., shared=shared)`` then starts from these
+    integrations instead of integrating again. For the geometry of the rows before they are edited."""
+    reg = build_registry(setup, pd.DataFrame(columns=["observable", "unit", "station_rx", "station_tx",
+                                                      "pass_id"]))
+    grid, _ = build_grid(reg, setup.start, setup.end, setup.block)
+    problem = TrackingProblem(reg, pd.DataFrame(), np.zeros(0), {setup.spacecraft: setup.force_model},
+                              setup.measurements, setup.start, setup.end, setup.lookback, epochs=grid,
+                              shared=shared, coarse=setup.coarse_integration)
+    problem.set_coarse(len(setup.sigma_scale) > 1)   # as the fit flies its first pass
+    starts, trajs = [], []
+    t, x = setup.start, reg.apriori
+    while t < setup.end:
+        seg = problem.segment(t, x)
+        starts.append(seg.a)
+        trajs.append(seg.trajs[setup.spacecraft])
+        x, _ = problem.transition(t, seg.b, x)
+        t = seg.b
+    return ReferenceChain(starts, trajs, setup.start, setup.end)
+
+
+def fit_arc(table: pd.DataFrame, setup: ArcSetup, shared: dict | None = None) -> ArcSolution:
     """Fit the arc; see :class:`ArcSetup` and :class:`ArcSolution`.
 
     Residual table columns: row (index in ``table``), epoch, observable, station_rx, pass_id,
@@ -258,6 +308,7 @@ def fit_arc(table: pd.DataFrame, setup: ArcSetup) -> ArcSolution:
     priori reference: the first iteration's pre-fit residual, row units), prefit/postfit (row units,
     last iteration), to_los (m or m/s per unit), apriori_los/prefit_los/postfit_los, sigma (row units, after reweighting), flags (Flag.RESIDUAL when
     edited by the fit), status (why a row could not be computed; such rows are not fitted).
+    ``shared``: reference segments already integrated for this arc (:func:`a_priori_reference`).
     """
     if setup.outward is not None:
         from .outward import fit_outward  # it fits windows of this arc through this function
@@ -274,9 +325,13 @@ def fit_arc(table: pd.DataFrame, setup: ArcSetup) -> ArcSolution:
         span = (setup.start - setup.lookback - 3600.0, setup.end + 3600.0)
         meas = spanning(meas, *span)
 
+    shared = {} if shared is None else shared
+
     def problem_for(r, t):
-        return TrackingProblem(reg, r, t, {setup.spacecraft: setup.force_model}, meas,
-                               setup.start, setup.end, setup.lookback, epochs=grid)
+        prob = TrackingProblem(reg, r, t, {setup.spacecraft: setup.force_model}, meas, setup.start, setup.end,
+                               setup.lookback, epochs=grid, shared=shared, coarse=setup.coarse_integration)
+        prob.set_coarse(len(options.sigma_scale) > 1)   # as the fit flies its first pass
+        return prob
 
     problem = problem_for(rows, times)
     computed, to_los, status = problem.reference(reg.apriori)

@@ -78,6 +78,7 @@ class _Segment:
     G_x: dict                  # sc -> (m, 6) d value / d x(a-)
     G_p: dict                  # sc -> (m, p) d value / d params (trajectory order)
     H_lin: np.ndarray          # (m, n) registry partials of the linear and clock terms
+    coarse: bool = False       # integrated with the coarse settings (set_coarse)
 
 
 class TrackingProblem:
@@ -89,12 +90,19 @@ class TrackingProblem:
     epochs: where transitions will be asked (the filter grid), evaluated per segment in one pass;
     integrator: spacecraft id -> :func:`propagate` settings overriding ``rtol``/``atol`` (fixed steps
     as an onboard filter takes them: ``{"rtol": inf, "max_step": 60}``, or ``{"method": "rk4",
-    "max_step": 60}``).
+    "max_step": 60}``);
+    coarse: integrator settings (e.g. ``{"rtol": 1e-9, "atol": 1e-5}``) of the references flown while
+    :meth:`set_coarse` is on (the fit's loose-weight stages, where a reference need not be exact), for the
+    spacecraft without ``integrator`` settings; None: always the exact ones;
+    shared: a dict shared by problems of one arc (e.g. the geometry step's a priori reference and the
+    fit's problems): a segment integrated by one from the same start state, parameter values and
+    settings is taken from it instead of integrated again (the latest per spacecraft and span is kept).
     """
 
     def __init__(self, registry, rows: pd.DataFrame, times: np.ndarray, force_models: dict,
                  setup: MeasurementSetup, t_start: float, t_end: float, lookback: float = 120.0,
-                 rtol: float = 1e-12, atol: float = 1e-6, epochs=(), integrator=None):
+                 rtol: float = 1e-12, atol: float = 1e-6, epochs=(), integrator=None, shared=None,
+                 coarse=None):
         self.registry = registry
         self.rows = rows.reset_index(drop=True)
         self.times = np.asarray(times, float)
@@ -106,6 +114,8 @@ class TrackingProblem:
         self.integrator = dict(integrator or {})
         self.epochs = np.asarray(epochs, float)
         self.n_propagations = 0
+        self.shared = {} if shared is None else shared
+        self.coarse, self._coarse = coarse, False
         self._segments: list[_Segment] = []
         self._last = (None, None)   # (segment, x1) of the last transition, to skip re-checks
         params = registry.parameters
@@ -149,10 +159,16 @@ class TrackingProblem:
             pts += [t for t in ix["maneuvers"] if self.t_start < t < self.t_end]
         return np.unique(np.asarray(pts, float))
 
+    def set_coarse(self, on: bool) -> None:
+        """Fly the references built from now on with the ``coarse`` settings (when given) or the exact ones."""
+        self._coarse = bool(on) and self.coarse is not None
+
     # -- segments -------------------------------------------------------
     def _find(self, t0, x0):
         for seg in self._segments:
             if seg.a <= t0 < seg.b:
+                if seg.coarse != self._coarse:
+                    return None
                 if (seg is self._last[0] and x0 is self._last[1] and t0 > seg.a) or self._agrees(seg, t0, x0):
                     return seg
                 return None
@@ -210,18 +226,51 @@ class TrackingProblem:
             dv = x0[dv_idx] if dv_idx is not None else None
             dt = x0[dt_idx] if dt_idx is not None else None
             settings = {"rtol": self.rtol, "atol": self.atol, **self.integrator.get(sc, {})}
-            trajs[sc] = SegmentTrajectory(x0[ix["state"]], a, b, fm, names, dv, self.lookback, dt=dt, **settings)
-            trajs[sc].preload(self.epochs[(self.epochs > a) & (self.epochs <= b)])
+            if self._coarse and sc not in self.integrator:
+                settings.update(self.coarse)
             pidx[sc] = np.array(idx + (dv_idx or []) + ([dt_idx] if dt_idx is not None else []), int)
-            self.n_propagations += 1
+            key = (x0[ix["state"]].tobytes(), x0[pidx[sc]].tobytes(), tuple(names),
+                   tuple(self.registry.names[i] for i in pidx[sc]), id(self.force_models[sc]), self.lookback,
+                   repr(sorted(settings.items())))
+            held = self.shared.get((sc, a, b))
+            if held is not None and held[0] == key:
+                trajs[sc] = held[1]
+            else:
+                trajs[sc] = SegmentTrajectory(x0[ix["state"]], a, b, fm, names, dv, self.lookback, dt=dt, **settings)
+                self.shared[(sc, a, b)] = (key, trajs[sc])
+                self.n_propagations += 1
+            trajs[sc].preload(self.epochs[(self.epochs > a) & (self.epochs <= b)])
         return b, trajs, pidx
+
+    def linearized(self, a: float, x_a: np.ndarray) -> tuple[float, dict] | None:
+        """(segment end b, sc -> ``states(t)`` (N, 6)) of the trajectory through ``x_a`` at ``a``, to first
+        order about the reference segment held from ``a`` (``x_ref(t) + stm(t) dx(a-) + S(t) dp``), without
+        integrating; None when no held segment starts at ``a``. The error is second order in the difference:
+        for a converged fit's last correction (the smoothed solution against the last reference) it is
+        negligible, which is what products use it for."""
+        seg = next((s for s in self._segments if s.a == a), None)
+        if seg is None:
+            return None
+        x_a = np.asarray(x_a, float)
+        ref = np.zeros(x_a.size)
+        ref[self._key_idx] = seg.key
+        out = {}
+        for sc, traj in seg.trajs.items():
+            dx = x_a[self._sc[sc]["state"]] - traj.x_start
+            dp = x_a[seg.pidx[sc]] - ref[seg.pidx[sc]]
+
+            def states(t, traj=traj, dx=dx, dp=dp):
+                return traj.state(t) + traj.stm(t) @ dx + traj.sensitivity(t) @ dp
+            out[sc] = states
+        return seg.b, out
 
     def _build(self, a, x0) -> _Segment:
         b, trajs, pidx = self.trajectories(a, x0)
         self._segments = [s for s in self._segments if s.b <= a or s.a >= b]
         lo = int(np.searchsorted(self.times, a, "left"))
         hi = self.times.size if b >= self.t_end else int(np.searchsorted(self.times, b, "left"))
-        seg = _Segment(a, b, x0[self._key_idx].copy(), trajs, pidx, lo, hi, *self._evaluate(lo, hi, trajs, x0))
+        seg = _Segment(a, b, x0[self._key_idx].copy(), trajs, pidx, lo, hi, *self._evaluate(lo, hi, trajs, x0),
+                       coarse=self._coarse)
         self._segments.append(seg)
         self._segments.sort(key=lambda s: s.a)
         return seg

@@ -135,10 +135,10 @@ def compile_note(main, outcomes) -> str:
             f"{w_n} in {w_s:.1f} s in the workers (once per checkout; later runs load them from the cache)")
 
 
-def run_demo(out: Path = Path("out/demo"), workers: int = 2, progress=print) -> dict:
-    """Run the whole demo into ``out``; returns the headline figures."""
+def run_demo(out: Path = Path("out/demo"), workers: int = 2, progress=print, days: float | None = None) -> dict:
+    """Run the whole demo into ``out`` (``days``: only the case's first days); returns the headline figures."""
     out = Path(out).resolve()
-    case = load_case(CASE)
+    case = load_case(CASE) if days is None else load_case(CASE).shortened(days)
     case_dir = out / "case"
     stem = case.name
     files = {"trk234": case_dir / f"{stem}.tnf", "tro": case_dir / f"{stem}.TRO", "ion": case_dir / f"{stem}.ION",
@@ -149,7 +149,7 @@ def run_demo(out: Path = Path("out/demo"), workers: int = 2, progress=print) -> 
     with compile_timer() as main_compile:
         if not all(p.exists() for p in files.values()):
             progress(f"simulating the case {CASE.name} into {case_dir} ...")
-            run_case(CASE, case_dir)
+            run_case(CASE, case_dir, days=days)
         truth = SpkTrajectory(files["spk"], case.naif_id)
         sigmas = data_sigmas(case)
         arc_dir = out / "arcs"

@@ -19,8 +19,11 @@ def fitted_segments(arc, step: float = 60.0) -> list[EphemerisSegment]:
     """The smoothed trajectory every ``step`` s, one product segment per maneuver-free span.
 
     Inside each dynamics segment of the fit (cut at maneuvers and stochastic
-    batches) the trajectory is the reference integrated from the smoothed
-    state and parameters at its start: exactly what the fit linearized about.
+    batches) the trajectory is the one through the smoothed state and
+    parameters at its start: for a converged fit the fit's last reference
+    corrected to first order (``problem.linearized``: no integration; the
+    correction is below the convergence tolerance, its square negligible),
+    otherwise integrated from them.
     At a maneuver the next segment starts after the burn, so a span ending at
     a maneuver ends with the state before it. Covariances are the smoothed
     ones at the filter grid epochs of the span.
@@ -43,9 +46,13 @@ def fitted_segments(arc, step: float = 60.0) -> list[EphemerisSegment]:
         start = a
         while start < b:
             k = int(np.searchsorted(grid, start, "left"))  # dynamics segments start on grid epochs
-            end, trajs, _ = problem.trajectories(grid[k], X[k])
+            near = problem.linearized(grid[k], X[k]) if arc.converged else None
+            if near is None:
+                end, trajs, _ = problem.trajectories(grid[k], X[k])
+                near = end, {sc: trajs[sc].state}
+            end, state = near[0], near[1][sc]
             sel = (t >= start) & ((t < end) | (end >= b))
-            states[sel] = trajs[sc].state(t[sel])
+            states[sel] = state(t[sel])
             start = end
         on = (grid >= a) & (grid <= b)
         segments.append(EphemerisSegment(t, states, center, P[on], grid[on]))

@@ -24,7 +24,7 @@ from odpipe.estimation.maneuvers import detect_maneuvers
 from odpipe.media.apply import calibrate
 from odpipe.media.ionosphere import IonexModel
 from odpipe.media.model import MediaModel
-from odpipe.od.arc import ManeuverPlan, fit_arc
+from odpipe.od.arc import ManeuverPlan, a_priori_reference, fit_arc
 from odpipe.pipeline import setup as build
 from odpipe.pipeline.config import RunConfig, load_config
 from odpipe.pipeline.geometry import add_geometry, apparent_itrs, median_round_trip
@@ -105,9 +105,10 @@ def _run(cfg: RunConfig, attempt, log: RunLog, fingerprint: dict) -> dict:
     fm = build.force_model(cfg)
     catalog = build.station_catalog(cfg)
     setup = build.arc_setup(cfg, fm, data.store, catalog)
-    apriori = build.a_priori_trajectory(setup)
+    shared: dict = {}   # reference segments: the a priori one integrated here is the fit's first
+    apriori = a_priori_reference(setup, shared)
     table = add_geometry(table, apriori, fm.ephemeris, catalog)
-    log(f"geometry: elevation and light time from the a priori trajectory ({apriori.n_steps} steps)")
+    log(f"geometry: elevation and light time from the a priori trajectory ({apriori.n_eval} force evaluations)")
 
     cal = cfg.calibration
     if cal.media:
@@ -138,20 +139,20 @@ def _run(cfg: RunConfig, attempt, log: RunLog, fingerprint: dict) -> dict:
     log("edit: " + ", ".join(f"{r} {n}" for r, n in zip(edits["reason"], edits["rows"]) if n))
 
     t0 = time.perf_counter()
-    arc = _fit(table, setup, log)
+    arc = _fit(table, setup, log, shared)
     if setup.outward is not None and cal.media:
         # the media came from the a priori orbit, far off away from its epoch: again from the fit, then refit
-        setup = replace(setup, state0=arc.states[0], outward=None)
-        table = media(table, build.a_priori_trajectory(setup))
+        setup, shared = replace(setup, state0=arc.states[0], outward=None), {}
+        table = media(table, a_priori_reference(setup, shared))
         log("calibrate: media again along the outward fit's orbit; the whole arc fitted again from it")
-        arc = _fit(table, setup, log)
+        arc = _fit(table, setup, log, shared)
     findings = unlogged_maneuvers(arc.residuals)
     log(f"innovation test for unlogged maneuvers: {len(findings)} finding(s)")
     sigma = cfg.estimation.detected_maneuver_sigma
     if len(findings) and sigma is not None:
         added = tuple(_detected_plan(k, f.after_tdb, f.epoch_tdb, sigma) for k, f in enumerate(findings.itertuples()))
         log(f"refit with {len(added)} detected maneuver(s) estimated ({sigma} m/s per axis a priori)")
-        arc = _fit(table, replace(setup, maneuvers=tuple(setup.maneuvers) + added), log)
+        arc = _fit(table, replace(setup, maneuvers=tuple(setup.maneuvers) + added), log, shared)
     fit_seconds = time.perf_counter() - t0
     return _products(cfg, attempt, log, table, arc, edits, fit_seconds, findings, fingerprint)
 
@@ -169,9 +170,9 @@ def _detected_plan(k: int, after: float, epoch: float, sigma: float) -> Maneuver
     return ManeuverPlan(f"detected{k}", after, sigma=sigma)
 
 
-def _fit(table, setup, log):
+def _fit(table, setup, log, shared):
     t0 = time.perf_counter()
-    arc = fit_arc(table, setup)
+    arc = fit_arc(table, setup, shared)
     for h in arc.history:
         log(f"fit iteration: {json.dumps(h, default=float)}", terminal=False)  # the fit logged it live
     log(f"fit: {'converged' if arc.converged else 'NOT converged'} in {len(arc.history)} iterations, "

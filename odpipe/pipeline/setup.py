@@ -162,14 +162,6 @@ def bias_apriori(est) -> dict:
     return out | {k: sigma_value("angle_", v) for k, v in est.angle_bias_apriori.items()}
 
 
-def a_priori_trajectory(setup: ArcSetup):
-    """The a priori trajectory over the arc (designed maneuvers applied), for geometry."""
-    fm = setup.force_model
-    burns = [F.ImpulsiveManeuver(m.epoch, m.designed) for m in setup.maneuvers]
-    model = F.ForceModel(fm.center, fm.components + burns, fm.mass, fm.ephemeris, fm.central_gm)
-    return propagate(setup.state0, setup.start, setup.end, model, with_stm=False)
-
-
 def input_files(cfg: RunConfig) -> list:
     """Every file whose bytes decide the run's result."""
     files = list(cfg.data.files) + cfg.data.stations + cfg.calibration.tro + cfg.calibration.ion + cfg.calibration.ionex
