@@ -4,7 +4,8 @@ Each variant writes its own run configurations (the nightly ones with some keys 
 made absolute) into ``OUT/<variant>/configs`` and runs them in this process with
 :func:`odpipe.pipeline.run.run_config` (so numba compiles once), chained as the nightly is:
 04-09 from the start-up fit, 04-10 from 04-09, 04-11 from 04-10, 04-08 from 04-09. A variant's
-arcs already complete and unchanged are skipped, so an interrupted driver resumes.
+arcs that already have a complete run (``OUT/<variant>/<arc>/current``) are not run again, so an interrupted
+driver resumes, and runs made elsewhere with the same settings (e.g. the nightly's own) can be copied in.
 """
 
 from __future__ import annotations
@@ -80,6 +81,9 @@ def run_variant(out: Path, overrides: dict, start_out: Path, arcs=ORDER, log=pri
         if SOURCE[name] != START and not isinstance(results.get(SOURCE[name], {}), dict):
             results[name] = f"source {SOURCE[name]} failed"
             continue
+        if (out / name / "current" / "summary.json").exists():
+            results[name] = {"status": "present"}
+            continue
         cfg = variant_config(name, out, overrides, src)
         try:
             results[name] = run_config(cfg, progress=None)
@@ -91,8 +95,9 @@ def run_variant(out: Path, overrides: dict, start_out: Path, arcs=ORDER, log=pri
 
 
 def run_start(out: Path) -> Path:
-    """The start-up fit (04-09 from its Doppler a priori), as configured, into ``out``."""
-    run_config(variant_config(START, out, {}, None), progress=None)
+    """The start-up fit (04-09 from its Doppler a priori), as configured, into ``out`` (unless there)."""
+    if not (out / START / "current" / "summary.json").exists():
+        run_config(variant_config(START, out, {}, None), progress=None)
     return out
 
 
