@@ -24,11 +24,13 @@ import os
 from contextlib import contextmanager
 from pathlib import Path
 
+import numpy as np
 import pandas as pd
 
 import odpipe.pipeline.run as pipeline_run
-from grail_arcs import run_variant, trajectory
-from odpipe.analysis.error_budget import formal_sigma, term_contribution
+from grail_arcs import PAIRS, run_variant, trajectory
+from odpipe.analysis.error_budget import earth_elevation_deg, formal_sigma, term_contribution
+from odpipe.environment.ephemeris import Ephemeris
 from odpipe.analysis.klobuchar import KlobucharIonosphere
 from odpipe.analysis.overlap import compare
 from odpipe.media.model import MediaModel
@@ -67,6 +69,24 @@ def _media(model):
         pipeline_run.MediaModel = saved
 
 
+def geometry(base: Path) -> pd.DataFrame:
+    """Per overlap of the nightly arcs: the Earth's elevation above the orbit plane at its middle, the
+    overlap seen and the formal sigma, R/I/C (m)."""
+    eph, rows = Ephemeris.open("de421"), []
+    for a, b in PAIRS:
+        oa, ob = (base / n / "current" / "trajectory.oem" for n in (a, b))
+        if not (oa.exists() and ob.exists()):
+            continue
+        s = compare(trajectory(base, a), trajectory(base, b), "", 60.0).statistics()
+        mid = 0.5 * (s["t_start_tdb"] + s["t_end_tdb"])
+        row = {"overlap": f"{a[-5:]} - {b[-5:]}", "earth_above_plane_deg": float(earth_elevation_deg(
+            trajectory(base, a), eph, np.array([mid]))[0])}
+        row |= {f"seen_{c}": s[f"pos_{c}_rms"] for c in ("radial", "intrack", "crosstrack", "3d")}
+        row |= {f"formal_{c}": v for c, v in formal_sigma(oa, ob).items()}
+        rows.append(row)
+    return pd.DataFrame(rows)
+
+
 def main(argv=None):
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--base", type=Path, default=Path("out/grail_loo/base"))
@@ -75,6 +95,10 @@ def main(argv=None):
     ap.add_argument("--terms", default=",".join(TERMS))
     args = ap.parse_args(argv)
     base, out = args.base.resolve(), args.out.resolve()
+    out.mkdir(parents=True, exist_ok=True)
+    geo = geometry(base)
+    geo.to_csv(out / "geometry.csv", index=False)
+    print(geo.round(2).to_string(index=False), flush=True)
     a, b = args.pair.split(",")
     source = "grail_b_2012_04_09" if a == "grail_b_2012_04_10" else None
     rows = []

@@ -95,3 +95,50 @@ def test_diagnosis_names_a_bad_ramp_segment():
     assert table.loc["DSS-54", "likely_cause"] == "ramp_segment"
     assert table.loc["DSS-54", "worst_segment"] == 107
     assert table.loc["DSS-54", "segment_offset_mm_s"] == pytest.approx(3.0, abs=0.5)
+
+
+class _Line:
+    """A trajectory on a straight line (m, m/s) plus a fixed offset, over [0, 3600] s."""
+
+    def __init__(self, offset=(0.0, 0.0, 0.0)):
+        self.offset, self.t0, self.t1 = np.asarray(offset, float), 0.0, 3600.0
+
+    def state(self, t):
+        t = np.atleast_1d(t)
+        x = np.zeros((t.size, 6))
+        x[:, 0] = 1.8e6
+        x[:, 4] = 1600.0 + 0 * t
+        x[:, 1] = 1600.0 * t
+        x[:, :3] += self.offset
+        return x
+
+
+def test_term_contribution_is_the_change_of_a_minus_the_change_of_b():
+    from odpipe.analysis.error_budget import term_contribution
+
+    # state along +x (radial), velocity +y (in-track): z is cross-track; A moves 30 m in z, B 10 m in -z
+    out = term_contribution(_Line(), _Line(), _Line((0, 0, 30.0)), _Line((0, 0, -10.0)))
+    assert out["crosstrack"] == pytest.approx(40.0) and out["radial"] == pytest.approx(0.0, abs=1e-9)
+    assert out["intrack"] == pytest.approx(0.0, abs=1e-6) and out["overlap_3d"] == pytest.approx(40.0)
+
+
+def test_earth_elevation_above_the_orbit_plane():
+    from odpipe.analysis.error_budget import earth_elevation_deg
+    from odpipe.environment.ephemeris import Ephemeris
+
+    eph = Ephemeris.open("de421")
+    t = np.array([387388866.0])
+    e = eph.position("earth", "moon", t)[0]
+    e /= np.linalg.norm(e)
+    u = np.cross(e, [0.0, 0.0, 1.0])
+    u /= np.linalg.norm(u)
+
+    class Orbit:  # position along u, velocity along e x u: the orbit normal is e (face-on); then edge-on
+        def __init__(self, v):
+            self.v = v
+
+        def state(self, tt):
+            return np.hstack([1.8e6 * u, 1600.0 * self.v])[None, :].repeat(len(tt), 0)
+
+    assert earth_elevation_deg(Orbit(np.cross(e, u)), eph, t)[0] == pytest.approx(90.0, abs=1e-6)
+    assert earth_elevation_deg(Orbit(e), eph, t)[0] == pytest.approx(0.0, abs=1e-6)

@@ -81,3 +81,14 @@ def formal_sigma(oem_a, oem_b) -> dict:
     S = rot @ (Pa[keep][:, :3, :3] + pb) @ np.transpose(rot, (0, 2, 1))
     sig = np.sqrt(np.mean(np.diagonal(S, axis1=1, axis2=2), axis=0))
     return dict(zip(COMPONENTS, sig)) | {"3d": float(np.sqrt(np.sum(sig**2)))}
+
+
+def earth_elevation_deg(traj, ephemeris, t_tdb) -> np.ndarray:
+    """Elevation (deg) of the Earth above the orbit plane of ``traj`` (about the Moon) at ``t_tdb``: near
+    90 deg the line of sight is along the orbit normal (Doppler sees cross-track, not in-track); near 0 it
+    lies in the plane (Doppler blind to cross-track)."""
+    x = traj.state(t_tdb)
+    h = np.cross(x[:, :3], x[:, 3:])
+    e = ephemeris.position("earth", "moon", np.atleast_1d(t_tdb))
+    s = np.sum(h * e, axis=1) / np.linalg.norm(h, axis=1) / np.linalg.norm(e, axis=1)
+    return np.degrees(np.arcsin(s))
