@@ -142,3 +142,19 @@ def test_earth_elevation_above_the_orbit_plane():
 
     assert earth_elevation_deg(Orbit(np.cross(e, u)), eph, t)[0] == pytest.approx(90.0, abs=1e-6)
     assert earth_elevation_deg(Orbit(e), eph, t)[0] == pytest.approx(0.0, abs=1e-6)
+
+
+def test_per_pass_doppler_biases_are_registered():
+    from odpipe.od.arc import ArcSetup, build_registry
+
+    rows = pd.DataFrame({"observable": ["doppler_2way"] * 4 + ["range"], "station_rx": ["DSS-24", "DSS-24", "DSS-34",
+                                                                                       "DSS-24", "DSS-24"],
+                         "pass_id": [3, 3, 5, 4, 3]})
+    setup = ArcSetup(spacecraft="181", start=0.0, end=1.0, state0=np.zeros(6), force_model=None, measurements=None,
+                     srp_scale_sigma=None, range_bias_sigma=None, doppler_bias_sigma=1e-3)
+    reg = build_registry(setup, rows)
+    biases = [p for p in reg.parameters if p.kind == "bias"]
+    assert [p.name for p in biases] == ["bias.doppler_2way.DSS-24.pass3", "bias.doppler_2way.DSS-34.pass5",
+                                        "bias.doppler_2way.DSS-24.pass4"]
+    assert all(p.sigma == 1e-3 and p.info["observable"] == "doppler_2way" for p in biases)
+    assert biases[1].info == {"observable": "doppler_2way", "station": "DSS-34", "spacecraft": "181", "pass_id": 5}

@@ -61,6 +61,7 @@ class ArcSetup:
     "36 arcsec", "1.7e-4 rad" (:data:`ANGLE_UNITS`).
     angle_bias_sigma: one constant bias (rad) per receiving station and angle observable (None: none).
     range_bias_sigma: per pass and receiving station (m; None: no biases; pass_id -1 = one per station).
+    doppler_bias_sigma: the same for two-way Doppler (m/s along the line of sight; None: no biases).
     oscillator_sigma: (y0, y1 1/s) sigmas of the one-way oscillator's fractional frequency offset and drift,
     when doppler_1way is fitted (a priori and reference epoch from ``measurements.oscillators``).
     station_sigma: considered (not estimated) error of each station's ITRS coordinates (m per axis).
@@ -85,6 +86,7 @@ class ArcSetup:
     maneuvers: tuple = ()
     data_sigma: dict = field(default_factory=lambda: dict(DATA_SIGMA))
     range_bias_sigma: float | None = 5.0
+    doppler_bias_sigma: float | None = None
     angle_bias_sigma: float | None = None
     oscillator_sigma: tuple | None = None
     station_sigma: float | None = None
@@ -189,13 +191,15 @@ def build_registry(setup: ArcSetup, rows: pd.DataFrame) -> ParameterRegistry:
         reg.add_stochastic_acceleration(sc, g.sigma, g.tau, g.batch)
     for m in setup.maneuvers:
         reg.add_maneuver(sc, m.label, m.epoch, m.sigma, m.designed, sigma_epoch=m.sigma_epoch)
-    if setup.range_bias_sigma is not None:
-        rng = rows[rows["observable"] == "range"]
-        for st, pid in rng[["station_rx", "pass_id"]].drop_duplicates().itertuples(index=False):
-            info = {"observable": "range", "station": st, "spacecraft": sc}
+    for obs, sigma in (("range", setup.range_bias_sigma), ("doppler_2way", setup.doppler_bias_sigma)):
+        if sigma is None:
+            continue
+        sel = rows[rows["observable"] == obs]
+        for st, pid in sel[["station_rx", "pass_id"]].drop_duplicates().itertuples(index=False):
+            info = {"observable": obs, "station": st, "spacecraft": sc}
             if pid >= 0:
                 info["pass_id"] = pid
-            reg.add(f"bias.range.{st}.pass{pid}", "bias", 0.0, setup.range_bias_sigma, owner=st, **info)
+            reg.add(f"bias.{obs}.{st}.pass{pid}", "bias", 0.0, sigma, owner=st, **info)
     if setup.angle_bias_sigma is not None:
         ang = rows[rows["unit"] == "rad"]
         for obs, st in ang[["observable", "station_rx"]].drop_duplicates().itertuples(index=False):

@@ -233,6 +233,8 @@ class EstimationSection:
                                                  default_factory=lambda: dict(DATA_SIGMA))
     # m, a per-pass range bias (none: not estimated)
     range_bias_sigma: float | None = checked(positive, default=ArcSetup.range_bias_sigma)
+    # m/s, a per-pass two-way Doppler bias (none: not estimated; odpipe.analysis.station_diagnostics)
+    doppler_bias_sigma: float | None = checked(positive, default=ArcSetup.doppler_bias_sigma)
     # one-way Doppler's oscillator, estimated when set: sigmas of its fractional frequency offset y0 and drift
     # y1 (1/s) about the arc start, one pair for every band it drives (a priori 0: the rows' reference)
     oscillator_sigma: list[float] | None = checked(positive, default=None)

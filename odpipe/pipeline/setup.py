@@ -129,6 +129,7 @@ def arc_setup(cfg: RunConfig, fm: F.ForceModel, ramps, catalog: StationCatalog) 
                     srp_scale_sigma=est.srp_scale_sigma if cfg.dynamics.srp is not None else None,
                     stochastic=stochastic, maneuvers=tuple(maneuver_plans(cfg, fm, state0, start)),
                     data_sigma=dict(est.data_sigma), range_bias_sigma=est.range_bias_sigma,
+                    doppler_bias_sigma=est.doppler_bias_sigma,
                     oscillator_sigma=None if est.oscillator_sigma is None else tuple(est.oscillator_sigma),
                     edit_k=tuple(est.edit_k), max_iter=est.max_iter, reweight=est.reweight,
                     sigma_scale=tuple(est.sigma_scale), block=est.block)
