@@ -41,7 +41,8 @@ def rows_used(residuals: pd.DataFrame, tracking: pd.DataFrame, ramps: pd.DataFra
                         "time": res["time"].to_numpy(float), "r": res["postfit_los"].to_numpy(float),
                         "rate": ((trk["value"].to_numpy(float) - res["prefit"].to_numpy(float))
                                  * res["to_los"].to_numpy(float)),
-                        "tropo_rate": trk["tropo_m"].to_numpy(float) / trk["count_time"].to_numpy(float),
+                        "tropo_rate": (trk["tropo_m"].to_numpy(float) if "tropo_m" in trk else np.nan)
+                        / trk["count_time"].to_numpy(float),
                         "segment": _segments(trk, ramps)})
     out = out.sort_values(["station", "pass_id", "time"], kind="stable").reset_index(drop=True)
     out["acc"] = np.nan
@@ -112,6 +113,8 @@ def diagnose(rows: pd.DataFrame, min_explained: float = 0.5, min_z: float = 6.0,
     estimated timing offset (ms) and troposphere scale, the worst ramp segment's offset (mm/s) and z, and
     the likely cause by the module's rules (``none``: smooth residuals, field-like). ``rows``: :func:`rows_used`."""
     lines = []
+    if not len(rows):
+        return pd.DataFrame(columns=["station", "rows", "passes", "rms_mm_s", "stands_out", "likely_cause"])
     for st, g in rows.groupby("station"):
         line = {"station": st, "rows": len(g), "passes": g["pass_id"].nunique(),
                 "rms_mm_s": float(np.sqrt(np.mean(g["r"] ** 2)) * 1e3)}
@@ -137,3 +140,29 @@ def diagnose(rows: pd.DataFrame, min_explained: float = 0.5, min_z: float = 6.0,
     median = table["rms_mm_s"].median()
     table.insert(4, "stands_out", (table["rms_mm_s"] > factor * median) | (table["rms_mm_s"] > max_rms * 1e3))
     return table
+
+
+CAUSES = {"timing": "a time-tag offset", "troposphere": "a troposphere (low-elevation) error",
+          "pass_bias": "a per-pass bias", "ramp_segment": "a bad ramp segment",
+          "none": "none found: smooth, field-like residuals"}
+
+
+def summary(table: pd.DataFrame) -> str:
+    """One sentence per standing-out station (or that none stands out) for a report."""
+    out = table[table["stands_out"].astype(bool)]
+    if not len(out):
+        return "No station stands out."
+    median = table["rms_mm_s"].median()
+    return " ".join(f"{r.station} stands out ({r.rms_mm_s:.2f} mm/s, {r.rms_mm_s / median:.1f} times the stations' "
+                    f"median); likely cause: {CAUSES[r.likely_cause]}." for r in out.itertuples())
+
+
+def report_table(table: pd.DataFrame) -> tuple[pd.DataFrame, dict]:
+    """(table, formats) of a :func:`diagnose` table for a report, with units in the headers."""
+    cols = {"station": "station", "rows": "rows", "rms_mm_s": "RMS (mm/s)", "stands_out": "stands out",
+            "timing_explained": "timing: explained", "timing_offset_ms": "timing offset (ms)",
+            "troposphere_explained": "troposphere: explained", "pass_bias_explained": "pass bias: explained",
+            "segment_offset_mm_s": "worst ramp segment (mm/s)", "segment_z": "its z", "likely_cause": "likely cause"}
+    shown = table[[c for c in cols if c in table]].rename(columns=cols)
+    fmt = {v: "{:.2f}" for k, v in cols.items() if k not in ("station", "rows", "stands_out", "likely_cause")}
+    return shown, {k: v for k, v in fmt.items() if k in shown}
