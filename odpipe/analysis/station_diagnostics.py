@@ -158,11 +158,18 @@ def summary(table: pd.DataFrame) -> str:
 
 
 def report_table(table: pd.DataFrame) -> tuple[pd.DataFrame, dict]:
-    """(table, formats) of a :func:`diagnose` table for a report, with units in the headers."""
-    cols = {"station": "station", "rows": "rows", "rms_mm_s": "RMS (mm/s)", "stands_out": "stands out",
-            "timing_explained": "timing: explained", "timing_offset_ms": "timing offset (ms)",
-            "troposphere_explained": "troposphere: explained", "pass_bias_explained": "pass bias: explained",
-            "segment_offset_mm_s": "worst ramp segment (mm/s)", "segment_z": "its z", "likely_cause": "likely cause"}
-    shown = table[[c for c in cols if c in table]].rename(columns=cols)
-    fmt = {v: "{:.2f}" for k, v in cols.items() if k not in ("station", "rows", "stands_out", "likely_cause")}
-    return shown, {k: v for k, v in fmt.items() if k in shown}
+    """(table, formats) of a :func:`diagnose` table for a report, with units in the headers: the RMS against
+    the stations' median, explained fractions in %, the timing offset in s, the ramp-segment z in sigmas,
+    and the likely cause as ``reason``."""
+    pct = {"timing_explained": "timing: explained (%)", "troposphere_explained": "troposphere: explained (%)",
+           "pass_bias_explained": "pass bias: explained (%)"}
+    shown = pd.DataFrame({"station_rx": table["station"], "rows": table["rows"], "RMS (mm/s)": table["rms_mm_s"],
+                          "RMS / median (1)": table["rms_mm_s"] / table["rms_mm_s"].median()})
+    for col, name in pct.items():
+        shown[name] = 100.0 * table.get(col, np.nan)
+    shown["timing offset (s)"] = table.get("timing_offset_ms", np.nan) / 1e3
+    shown["worst ramp segment (mm/s)"] = table.get("segment_offset_mm_s", np.nan)
+    shown["its offset (sigma)"] = table.get("segment_z", np.nan)
+    shown["reason"] = table["likely_cause"].map(CAUSES)
+    fmt = {c: "{:.2f}" for c in shown.columns if c not in ("station_rx", "rows", "reason")}
+    return shown, fmt | {"timing offset (s)": "{:.5f}", "RMS / median (1)": "{:.1f}"}
