@@ -87,18 +87,38 @@ def geometry(base: Path) -> pd.DataFrame:
     return pd.DataFrame(rows)
 
 
+def variant_terms(base: Path, variants) -> pd.DataFrame:
+    """Contributions to every nightly overlap of settings changed in leave-one-out variants (folders beside
+    ``base``, e.g. the field to degree 100, other stochastic accelerations): (A' - A) - (B' - B), R/I/C (m)."""
+    rows = []
+    for v in variants:
+        for a, b in PAIRS:
+            runs = [base.parent / v / n / "current" / "trajectory.oem" for n in (a, b)]
+            if all(r.exists() for r in runs) and all((base / n / "current").exists() for n in (a, b)):
+                rows.append({"term": v, "overlap": f"{a[-5:]} - {b[-5:]}", **term_contribution(
+                    trajectory(base, a), trajectory(base, b), trajectory(base.parent / v, a),
+                    trajectory(base.parent / v, b))})
+    return pd.DataFrame(rows)
+
+
 def main(argv=None):
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--base", type=Path, default=Path("out/grail_loo/base"))
     ap.add_argument("--out", type=Path, default=Path("out/grail_budget"))
     ap.add_argument("--pair", default="grail_b_2012_04_10,grail_b_2012_04_11")
     ap.add_argument("--terms", default=",".join(TERMS))
+    ap.add_argument("--variants", default="", help="leave-one-out variants beside --base to difference (no fits)")
     args = ap.parse_args(argv)
     base, out = args.base.resolve(), args.out.resolve()
     out.mkdir(parents=True, exist_ok=True)
     geo = geometry(base)
     geo.to_csv(out / "geometry.csv", index=False)
     print(geo.round(2).to_string(index=False), flush=True)
+    if args.variants:
+        terms = variant_terms(base, args.variants.split(","))
+        terms.to_csv(out / "variant_terms.csv", index=False)
+        print(terms.round(2).to_string(index=False), flush=True)
+        return
     a, b = args.pair.split(",")
     source = "grail_b_2012_04_09" if a == "grail_b_2012_04_10" else None
     rows = []
