@@ -26,6 +26,7 @@ CANDIDATES = {
     "base": {},
     "q3e-8": {"estimation.stochastic.sigma": "3e-8"},
     "q3e-7": {"estimation.stochastic.sigma": "3e-7"},
+    "q2e-7": {"estimation.stochastic.sigma": "2e-7"},
     "deg100": {"dynamics.gravity.degree": "100"},
     "reweight": {"estimation.reweight": "true"},
     "edit3": {"estimation.edit_k": "[1e6, 10.0, 3.0]"},
