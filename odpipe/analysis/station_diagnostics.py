@@ -6,7 +6,8 @@ known fault leaves in them:
 * ``timing``: a time-tag offset dt (s, tags late) leaves r = -a dt, a the rows' line-of-sight
   acceleration (the time derivative of the computed range rate along each pass);
 * ``troposphere``: a troposphere model wrong by a fraction s leaves r = s g, g the model's own
-  Doppler correction (``tropo_m`` over the count time, m/s), largest at low elevation;
+  Doppler correction (``tropo_m`` over the count time, m/s), largest at low elevation (counted beyond
+  the pass biases: see :func:`signature_fit`);
 * ``pass_bias``: a constant offset per pass (what a per-pass Doppler bias parameter absorbs);
 * ``ramp_segment``: one uplink ramp segment offset from its neighbours (a bad ramp record).
 
@@ -78,16 +79,29 @@ def _design(g: pd.DataFrame, signature: str) -> np.ndarray:
     return (passes[:, None] == np.unique(passes)[None, :]).astype(float)
 
 
+def _ss(A: np.ndarray, r: np.ndarray) -> float:
+    x, *_ = np.linalg.lstsq(A, r, rcond=None)
+    return float(np.sum((r - A @ x) ** 2))
+
+
 def signature_fit(g: pd.DataFrame, signature: str) -> dict:
-    """Least-squares fit of one signature to one station's residuals: parameters and explained fraction."""
+    """Least-squares fit of one signature to one station's residuals: parameters and the fraction of the
+    residual variance it explains. The troposphere's fraction is what it explains beyond the pass biases
+    (its Doppler signature changes sign between a pass's rise and set; on one side of a pass alone it
+    would pass for a bias)."""
     A = _design(g, signature)
     ok = np.all(np.isfinite(A), axis=1) & np.isfinite(g["r"].to_numpy())
     A, r = A[ok], g["r"].to_numpy()[ok]
-    if r.size <= A.shape[1]:
+    if r.size <= A.shape[1] or not np.any(A):
         return {"signature": signature, "explained": 0.0, "params": np.zeros(A.shape[1])}
     x, *_ = np.linalg.lstsq(A, r, rcond=None)
-    ss0, ss1 = float(r @ r), float(np.sum((r - A @ x) ** 2))
-    return {"signature": signature, "explained": (ss0 - ss1) / ss0 if ss0 > 0 else 0.0, "params": x}
+    ss0 = float(r @ r)
+    if signature == "troposphere":
+        B = _design(g[ok], "pass_bias")
+        gain = _ss(B, r) - _ss(np.column_stack([A, B]), r)
+    else:
+        gain = ss0 - _ss(A, r)
+    return {"signature": signature, "explained": gain / ss0 if ss0 > 0 else 0.0, "params": x}
 
 
 def segment_offsets(g: pd.DataFrame) -> pd.DataFrame:
