@@ -73,6 +73,7 @@ class ArcSetup:
     polynomial_sigma: (c0 m/s^2, c1 m/s^3) a priori sigmas of every inertial polynomial acceleration's
     coefficients (None: fixed; a priori the model's values).
     outward: (epoch TDB s, first half-window s, factor): fit outward from that epoch (:mod:`.outward`).
+    doppler_bias_sigma: per pass and receiving station, two-way Doppler (m/s along the line of sight; None: none).
     oscillator_sigma: (y0, y1 1/s) sigmas of the one-way oscillator's fractional frequency offset and drift,
     when doppler_1way is fitted (a priori and reference epoch from ``measurements.oscillators``).
     station_sigma: considered (not estimated) error of each station's ITRS coordinates (m per axis).
@@ -100,6 +101,7 @@ class ArcSetup:
     data_sigma: dict = field(default_factory=lambda: dict(DATA_SIGMA))
     range_bias_sigma: float | None = 5.0
     range_bias_per: str = "pass"
+    doppler_bias_sigma: float | None = None
     angle_bias_sigma: float | None = None
     bias_apriori: dict = field(default_factory=dict)
     cd_sigma: float | None = None
@@ -222,16 +224,17 @@ def build_registry(setup: ArcSetup, rows: pd.DataFrame) -> ParameterRegistry:
         reg.add_stochastic_acceleration(sc, g.sigma, g.tau, g.batch)
     for m in setup.maneuvers:
         reg.add_maneuver(sc, m.label, m.epoch, m.sigma, m.designed, sigma_epoch=m.sigma_epoch)
-    if setup.range_bias_sigma is not None:
-        rng = rows.loc[rows["observable"] == "range", ["station_rx", "pass_id"]]
-        if setup.range_bias_per == "station":
-            rng = rng.assign(pass_id=-1)
-        for st, pid in rng.drop_duplicates().itertuples(index=False):
-            info = {"observable": "range", "station": st, "spacecraft": sc}
+    for obs, sigma in (("range", setup.range_bias_sigma), ("doppler_2way", setup.doppler_bias_sigma)):
+        if sigma is None:
+            continue
+        sel = rows.loc[rows["observable"] == obs, ["station_rx", "pass_id"]]
+        if obs == "range" and setup.range_bias_per == "station":
+            sel = sel.assign(pass_id=-1)
+        for st, pid in sel.drop_duplicates().itertuples(index=False):
+            info = {"observable": obs, "station": st, "spacecraft": sc}
             if pid >= 0:
                 info["pass_id"] = pid
-            reg.add(f"bias.range.{st}.pass{pid}", "bias", _bias_apriori(setup, "range", st), setup.range_bias_sigma,
-                    owner=st, **info)
+            reg.add(f"bias.{obs}.{st}.pass{pid}", "bias", _bias_apriori(setup, obs, st), sigma, owner=st, **info)
     if setup.angle_bias_sigma is not None:
         ang = rows[rows["unit"] == "rad"]
         for obs, st in ang[["observable", "station_rx"]].drop_duplicates().itertuples(index=False):

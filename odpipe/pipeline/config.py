@@ -335,6 +335,8 @@ class EstimationSection:
     cd_sigma: float | None = checked(positive, default=None)  # a priori sigma of the drag Cd (none: fixed)
     # a priori sigmas of the polynomial acceleration's c0 (m/s²) and c1 (m/s³), each axis (none: fixed)
     polynomial_sigma: list[float] | None = checked(positive, default=None)
+    # m/s, a per-pass two-way Doppler bias (none: not estimated; odpipe.analysis.station_diagnostics)
+    doppler_bias_sigma: float | None = checked(positive, default=ArcSetup.doppler_bias_sigma)
     # one-way Doppler's oscillator, estimated when set: sigmas of its fractional frequency offset y0 and drift
     # y1 (1/s) about the arc start, one pair for every band it drives (a priori 0: the rows' reference)
     oscillator_sigma: list[float] | None = checked(positive, default=None)

@@ -20,6 +20,7 @@ import pandas as pd
 
 from odpipe import __version__
 from odpipe.analysis import maneuvers as maneuver_report
+from odpipe.analysis import station_diagnostics
 from odpipe.estimation.maneuvers import detect_maneuvers
 from odpipe.media.apply import calibrate
 from odpipe.media.ionosphere import IonexModel
@@ -154,7 +155,7 @@ def _run(cfg: RunConfig, attempt, log: RunLog, fingerprint: dict) -> dict:
         log(f"refit with {len(added)} detected maneuver(s) estimated ({sigma} m/s per axis a priori)")
         arc = _fit(table, replace(setup, maneuvers=tuple(setup.maneuvers) + added), log, shared)
     fit_seconds = time.perf_counter() - t0
-    return _products(cfg, attempt, log, table, arc, edits, fit_seconds, findings, fingerprint)
+    return _products(cfg, attempt, log, table, arc, edits, fit_seconds, findings, fingerprint, data.ramps)
 
 
 MAX_EPOCH_WINDOW_S = 600.0  # s: a burn found between rows closer than this also gets its epoch estimated
@@ -197,7 +198,7 @@ def unlogged_maneuvers(res: pd.DataFrame, window: int = 20, p_false: float = 1e-
     return out
 
 
-def _products(cfg, attempt, log, table, arc, edits, fit_seconds, findings, fingerprint) -> dict:
+def _products(cfg, attempt, log, table, arc, edits, fit_seconds, findings, fingerprint, ramps=None) -> dict:
     res = arc.residuals
     stats = residuals.statistics(res)
     write_parquet(attempt.product("tracking.parquet"), table)
@@ -205,6 +206,8 @@ def _products(cfg, attempt, log, table, arc, edits, fit_seconds, findings, finge
     write_text(attempt.product("residual_statistics.csv"), stats.to_csv(index=False))
     per_pass = residuals.statistics(res, by=("station_rx", "observable", "pass_id"))
     write_text(attempt.product("residual_statistics_passes.csv"), per_pass.to_csv(index=False))
+    diag = station_diagnostics.diagnose(station_diagnostics.rows_used(res, table, ramps))
+    write_text(attempt.product("station_diagnostics.csv"), diag.to_csv(index=False))
     params = parameters.with_units(arc.parameters)
     write_text(attempt.product("parameters.csv"), params.to_csv(index=False))
     man_rows = man_stats = None
@@ -232,7 +235,7 @@ def _products(cfg, attempt, log, table, arc, edits, fit_seconds, findings, finge
     write_text(attempt.product("summary.json"), json.dumps(summary, indent=1, default=float))
     write_text(attempt.product("unlogged_maneuvers.csv"), findings.to_csv(index=False))
     write_report(attempt.product("report.html"), f"odpipe run {cfg.run.name}", _headline(summary),
-                 _sections(cfg, res, stats, per_pass, edits, params, figures, findings, man_rows, man_stats,
+                 _sections(cfg, res, stats, per_pass, diag, edits, params, figures, findings, man_rows, man_stats,
                            arc.maneuvers["epoch"].to_numpy(float) if len(arc.maneuvers) else None))
     log(f"products: OEM/SPK ({sum(len(s.t_tdb) for s in segments)} states in {len(segments)} segments), "
         "residuals, parameters, report.html")
@@ -247,7 +250,7 @@ def provenance(cfg, fingerprint: dict, what: str) -> list[str]:
     return lines + [f"input: {Path(p).name} sha256 {h}" for p, h in fingerprint["inputs"].items()]
 
 
-def _sections(cfg, res, stats, per_pass, edits, params, figures, findings, man_rows, man_stats,
+def _sections(cfg, res, stats, per_pass, diag, edits, params, figures, findings, man_rows, man_stats,
               man_epochs) -> list[Section]:
     resid = Section("Residuals per station").text(
         "Along the line of sight: Doppler in mm/s, range in m; the pre-fit residuals are against the a priori "
@@ -256,6 +259,8 @@ def _sections(cfg, res, stats, per_pass, edits, params, figures, findings, man_r
     for png, caption in figures:
         resid.figure(png, caption)
     sections = [resid, Section("Residuals per pass").tables(residuals.report_tables(per_pass)),
+                Section("Station diagnostics (two-way Doppler)").text(station_diagnostics.summary(diag)).table(
+                    *station_diagnostics.report_table(diag)),
                 Section("Editing").text("Where every row went: the preprocessing editors (a row with two reasons "
                                         "counts in both), then the fit; 'fitted' is the residual tables' used "
                                         "rows.").table(residuals.edit_summary(edits, res)),

@@ -1,0 +1,160 @@
+"""The GRAIL accuracy tools: the leave-one-out rule, the Klobuchar-size ionosphere, station diagnostics."""
+
+import numpy as np
+import pandas as pd
+import pytest
+
+from odpipe.analysis.klobuchar import KlobucharIonosphere
+from odpipe.analysis.leave_one_out import choose, held_out
+from odpipe.analysis.station_diagnostics import diagnose
+
+ARCS = ("a1", "a2", "a3", "a4")
+
+
+def _figures(rms: dict, overlap: dict):
+    """rms: {(candidate, arc): worst rms}; overlap: {(candidate, pair index): 3D RMS}."""
+    arcs = pd.DataFrame([{"candidate": c, "arc": a, "converged": True, "worst_rms": v} for (c, a), v in rms.items()])
+    pairs = list(zip(ARCS[:-1], ARCS[1:]))
+    ov = pd.DataFrame([{"candidate": c, "a": pairs[k][0], "b": pairs[k][1], "pos_3d_rms": v, "radial": 1.0,
+                        "intrack": v, "crosstrack": 0.0} for (c, k), v in overlap.items()])
+    return arcs, ov
+
+
+def test_rule_never_sees_the_judged_arc():
+    # "x" has the best overlaps everywhere except those touching a4, where it is far worse than "y"
+    rms = {(c, a): 1.0 for c in "xy" for a in ARCS}
+    overlap = {("x", 0): 100.0, ("x", 1): 100.0, ("x", 2): 5000.0, ("y", 0): 200.0, ("y", 1): 200.0, ("y", 2): 300.0}
+    arcs, ov = _figures(rms, overlap)
+    assert choose(arcs, ov, ["a1", "a2", "a3"]) == "x"   # a4's overlap (pair 2) is not seen
+    assert choose(arcs, ov, ["a2", "a3", "a4"]) == "y"   # pairs 1 and 2: mean 2550 vs 250
+    table = held_out(arcs, ov).set_index("arc")
+    assert table.loc["a4", "candidate"] == "x"
+    assert table.loc["a4", "overlap_a3_pos_3d_rms"] == 5000.0
+    assert table.loc["a1", "candidate"] == "y" and table.loc["a1", "overlap_a2_pos_3d_rms"] == 200.0
+
+
+def test_rule_prefers_admissible_candidates():
+    # "x" overlaps best but leaves a station above 2 mm/s on a training arc
+    rms = {(c, a): 1.0 for c in "xy" for a in ARCS} | {("x", "a2"): 2.5}
+    overlap = {(c, k): (100.0 if c == "x" else 400.0) for c in "xy" for k in range(3)}
+    arcs, ov = _figures(rms, overlap)
+    assert choose(arcs, ov, ["a1", "a2", "a3"]) == "y"
+    assert choose(arcs, ov, ["a1", "a3", "a4"]) == "x"
+    assert choose(arcs, ov, ["a1", "a2", "a3"], max_rms=3.0) == "x"
+
+
+def test_klobuchar_night_floor_and_day_peak():
+    """IS-GPS-200: 5 ns at night times the obliquity F = 1 + 16 (0.53 - E)^3; at 14:00 local time at the
+    pierce point, 5 ns + AMP. Zenith (E = 0.5 semicircle), azimuth 0, longitude 0: the pierce point's
+    local time is UTC. 1 TECU is 0.1624 m of L1 group delay (40.3e16 / f_L1^2)."""
+    model = KlobucharIonosphere(alpha=(1e-8, 0, 0, 0), beta=(72000.0, 0, 0, 0))
+    f = 1 + 16 * 0.03**3
+    night = model.l1_delay(0.3, 0.0, 0.0, np.pi / 2, np.datetime64("2012-04-10T02:00"))
+    peak = model.l1_delay(0.3, 0.0, 0.0, np.pi / 2, np.datetime64("2012-04-10T14:00"))
+    assert night == pytest.approx(f * 5e-9, rel=1e-12)
+    assert peak == pytest.approx(f * 15e-9, rel=1e-12)
+    tec = model.slant_tec(0.3, 0.0, 0.0, np.pi / 2, np.datetime64("2012-04-10T02:00"))
+    assert tec * 0.16237 == pytest.approx(f * 5e-9 * 299792458.0, rel=1e-4)
+    assert KlobucharIonosphere(scale=2.0).slant_tec(0.3, 0.0, 1.0, 0.4, np.datetime64("2012-04-10T12:00")) == \
+        pytest.approx(2 * KlobucharIonosphere().slant_tec(0.3, 0.0, 1.0, 0.4, np.datetime64("2012-04-10T12:00")))
+
+
+def _smooth_station(rng, station, n_pass=3, rows=55, amp=1e-3):
+    """Field-like residuals: smooth random sinusoids per pass (m/s), with LOS acceleration and tropo rate."""
+    out = []
+    for p in range(n_pass):
+        t = np.arange(rows) * 60.0 + p * 7200.0
+        r = amp * np.sin(2 * np.pi * t / rng.uniform(1500, 4000) + rng.uniform(0, 6)) + 1e-5 * rng.standard_normal(rows)
+        out.append(pd.DataFrame({"station": station, "pass_id": p + 10 * len(station), "time": t, "r": r,
+                                 "acc": 0.3 * np.cos(2 * np.pi * t / 6800.0 + p),
+                                 "tropo_rate": 1e-4 * (t - t.mean()) / 1800.0,
+                                 "segment": p * 100 + (np.arange(rows) // 3)}))
+    return pd.concat(out, ignore_index=True)
+
+
+def test_diagnosis_names_an_injected_timing_offset():
+    rng = np.random.default_rng(3)
+    rows = pd.concat([_smooth_station(rng, s) for s in ("DSS-24", "DSS-34", "DSS-54")], ignore_index=True)
+    quiet = diagnose(rows).set_index("station")
+    assert (quiet["likely_cause"] == "none").all() and not quiet["stands_out"].any()
+    dt = 0.01  # s: 10 ms late tags -> up to 3 mm/s
+    hit = rows["station"] == "DSS-34"
+    rows.loc[hit, "r"] -= rows.loc[hit, "acc"] * dt
+    table = diagnose(rows).set_index("station")
+    assert table.loc["DSS-34", "likely_cause"] == "timing" and table.loc["DSS-34", "stands_out"]
+    assert table.loc["DSS-34", "timing_offset_ms"] == pytest.approx(10.0, abs=1.0)
+    assert (table.drop("DSS-34")["likely_cause"] == "none").all()
+
+
+def test_diagnosis_names_a_bad_ramp_segment():
+    rng = np.random.default_rng(4)
+    rows = pd.concat([_smooth_station(rng, s) for s in ("DSS-24", "DSS-34", "DSS-54")], ignore_index=True)
+    bad = (rows["station"] == "DSS-54") & (rows["segment"] == 107)
+    rows.loc[bad, "r"] += 3e-3
+    table = diagnose(rows).set_index("station")
+    assert table.loc["DSS-54", "likely_cause"] == "ramp_segment"
+    assert table.loc["DSS-54", "worst_segment"] == 107
+    assert table.loc["DSS-54", "segment_offset_mm_s"] == pytest.approx(3.0, abs=0.5)
+
+
+class _Line:
+    """A trajectory on a straight line (m, m/s) plus a fixed offset, over [0, 3600] s."""
+
+    def __init__(self, offset=(0.0, 0.0, 0.0)):
+        self.offset, self.t0, self.t1 = np.asarray(offset, float), 0.0, 3600.0
+
+    def state(self, t):
+        t = np.atleast_1d(t)
+        x = np.zeros((t.size, 6))
+        x[:, 0] = 1.8e6
+        x[:, 4] = 1600.0 + 0 * t
+        x[:, 1] = 1600.0 * t
+        x[:, :3] += self.offset
+        return x
+
+
+def test_term_contribution_is_the_change_of_a_minus_the_change_of_b():
+    from odpipe.analysis.error_budget import term_contribution
+
+    # state along +x (radial), velocity +y (in-track): z is cross-track; A moves 30 m in z, B 10 m in -z
+    out = term_contribution(_Line(), _Line(), _Line((0, 0, 30.0)), _Line((0, 0, -10.0)))
+    assert out["crosstrack"] == pytest.approx(40.0) and out["radial"] == pytest.approx(0.0, abs=1e-9)
+    assert out["intrack"] == pytest.approx(0.0, abs=1e-6) and out["overlap_3d"] == pytest.approx(40.0)
+
+
+def test_earth_elevation_above_the_orbit_plane():
+    from odpipe.analysis.error_budget import earth_elevation_deg
+    from odpipe.environment.ephemeris import Ephemeris
+
+    eph = Ephemeris.open("de421")
+    t = np.array([387388866.0])
+    e = eph.position("earth", "moon", t)[0]
+    e /= np.linalg.norm(e)
+    u = np.cross(e, [0.0, 0.0, 1.0])
+    u /= np.linalg.norm(u)
+
+    class Orbit:  # position along u, velocity along e x u: the orbit normal is e (face-on); then edge-on
+        def __init__(self, v):
+            self.v = v
+
+        def state(self, tt):
+            return np.hstack([1.8e6 * u, 1600.0 * self.v])[None, :].repeat(len(tt), 0)
+
+    assert earth_elevation_deg(Orbit(np.cross(e, u)), eph, t)[0] == pytest.approx(90.0, abs=1e-6)
+    assert earth_elevation_deg(Orbit(e), eph, t)[0] == pytest.approx(0.0, abs=1e-6)
+
+
+def test_per_pass_doppler_biases_are_registered():
+    from odpipe.od.arc import ArcSetup, build_registry
+
+    rows = pd.DataFrame({"observable": ["doppler_2way"] * 4 + ["range"], "station_rx": ["DSS-24", "DSS-24", "DSS-34",
+                                                                                       "DSS-24", "DSS-24"],
+                         "pass_id": [3, 3, 5, 4, 3]})
+    setup = ArcSetup(spacecraft="181", start=0.0, end=1.0, state0=np.zeros(6), force_model=None, measurements=None,
+                     srp_scale_sigma=None, range_bias_sigma=None, doppler_bias_sigma=1e-3)
+    reg = build_registry(setup, rows)
+    biases = [p for p in reg.parameters if p.kind == "bias"]
+    assert [p.name for p in biases] == ["bias.doppler_2way.DSS-24.pass3", "bias.doppler_2way.DSS-34.pass5",
+                                        "bias.doppler_2way.DSS-24.pass4"]
+    assert all(p.sigma == 1e-3 and p.info["observable"] == "doppler_2way" for p in biases)
+    assert biases[1].info == {"observable": "doppler_2way", "station": "DSS-34", "spacecraft": "181", "pass_id": 5}
