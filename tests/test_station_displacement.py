@@ -67,3 +67,12 @@ def test_ocean_loading_sites_found_by_station_name(shared_data):
     assert 0.005 < np.abs(ocean).max() < 0.03           # SHLD's K1 + M2 loading: about a centimetre
     assert not StationDisplacement(False, by_station).displacement(
         Station("7090", shld.r_itrs), t, base.ephemeris, base.gcrs_to_itrs).any()
+
+
+def test_config_keys_build_the_displacement(shared_data):
+    from odpipe.pipeline.config import MeasurementsSection
+    from odpipe.pipeline.setup import station_displacement
+
+    assert station_displacement(MeasurementsSection()) is None
+    d = station_displacement(MeasurementsSection(station_tides=True, ocean_loading=shared_data / GNSS_BLQ))
+    assert d.solid_tides and d.ocean_loading["SHLD"].name == "SHLD/C1" and len(d.ocean_loading) == 20
