@@ -3,7 +3,6 @@
 from pathlib import Path
 
 import numpy as np
-import pytest
 
 from odpipe.environment.ocean_loading import ocean_loading_displacement
 from odpipe.environment.station_displacement import StationDisplacement, sites_by_station
