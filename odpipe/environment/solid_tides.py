@@ -49,7 +49,7 @@ _LONG_PERIOD = np.array([
     (2, 0, 0, 1, 0, -0.05, -0.05, -0.06, -0.03)])
 
 
-def _doodson_angles(t_cent: np.ndarray, ut_hours: np.ndarray):
+def doodson_angles(t_cent: np.ndarray, ut_hours: np.ndarray):
     """(tau, s, h, p, N', ps) in degrees at TT centuries past J2000 and UT hours of day."""
     t = t_cent
     s = 218.31664563 + (481267.88194 + (-0.0014663889 + 0.00000185139 * t) * t) * t
@@ -117,7 +117,7 @@ def solid_earth_tide(r_station, r_sun, r_moon, epoch_utc) -> np.ndarray:
           + 3 * l1_d * sinphi * cos2phi * d1 - 1.5 * l1_s * sinphi**2 * cosphi * a2)
 
     # step 2: frequency dependence, diurnal band (Table 7.3a) and long period (Table 7.3b), mm
-    tau, args = _doodson_angles(tt_cent, ut_hours)
+    tau, args = doodson_angles(tt_cent, ut_hours)
     theta = np.radians(tau[..., None] + args @ _DIURNAL[:, :5].T) + lam[..., None]
     sin_t, cos_t = np.sin(theta), np.cos(theta)
     dr += 1e-3 * 2 * sinphi * cosphi * (sin_t @ _DIURNAL[:, 5] + cos_t @ _DIURNAL[:, 6])
@@ -131,17 +131,19 @@ def solid_earth_tide(r_station, r_sun, r_moon, epoch_utc) -> np.ndarray:
     return disp + dr[..., None] * e_r + dn[..., None] * e_n + de[..., None] * e_e
 
 
-def station_tide_displacement(r_station_itrs, epoch_utc, ephemeris) -> np.ndarray:
-    """Solid-tide displacement (…,3) m in ITRS at UTC epochs, Sun and Moon from ``ephemeris``.
+def station_tide_displacement(r_station_itrs, t, ephemeris, gcrs_to_itrs=None) -> np.ndarray:
+    """Solid-tide displacement (…,3) m in ITRS at epochs ``t``, Sun and Moon from ``ephemeris``.
 
-    Convenience wrapper: geocentric Sun/Moon (aberration-free geometric positions;
-    the light-time effect is < 1e-6 relative) rotated to ITRS, then :func:`solid_earth_tide`.
+    ``t``: UTC datetime64 or TDB s past J2000; ``gcrs_to_itrs``: rotation callable of TDB s (default
+    the IAU 2006/2000A rotation with EOP, ``odpipe.frames.earth.gcrs_to_itrs``). Geocentric Sun/Moon
+    are geometric (the light-time effect is < 1e-6 relative), rotated to ITRS, then :func:`solid_earth_tide`.
     """
-    from odpipe.frames.earth import gcrs_to_itrs
-    from odpipe.time.scales import utc_to_tdb
+    from odpipe.frames.earth import gcrs_to_itrs as full_rotation
+    from odpipe.time.scales import tdb_to_utc, utc_to_tdb
 
-    t = utc_to_tdb(epoch_utc)
-    m = gcrs_to_itrs(np.asarray(epoch_utc).astype("datetime64[ns]"))
-    sun = np.einsum("...ij,...j->...i", m, ephemeris.position("sun", "earth", t))
-    moon = np.einsum("...ij,...j->...i", m, ephemeris.position("moon", "earth", t))
-    return solid_earth_tide(r_station_itrs, sun, moon, epoch_utc)
+    arr = np.asarray(t)
+    utc, tdb = (arr, utc_to_tdb(arr)) if arr.dtype.kind == "M" else (tdb_to_utc(arr), arr.astype(float))
+    m = (gcrs_to_itrs or full_rotation)(tdb)
+    sun = np.einsum("...ij,...j->...i", m, ephemeris.position("sun", "earth", tdb))
+    moon = np.einsum("...ij,...j->...i", m, ephemeris.position("moon", "earth", tdb))
+    return solid_earth_tide(r_station_itrs, sun, moon, utc)

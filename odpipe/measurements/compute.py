@@ -78,6 +78,8 @@ class MeasurementSetup:
     stations (LAGEOS: 0.251 m): each leg of a ``range`` row is that much shorter than to the centre of mass.
     elevation_refraction: ``angle_el`` rows are apparent elevations, the free-space one bent by the ITU-R P.834
     reference atmosphere at the station's height (:mod:`.refraction`).
+    station_displacement: a :class:`odpipe.environment.station_displacement.StationDisplacement` (solid tide,
+    ocean loading) added to every station's catalogue position at each epoch; None: catalogue positions.
     """
 
     ephemeris: object
@@ -92,6 +94,7 @@ class MeasurementSetup:
     clocks: dict = field(default_factory=dict)
     com_offsets: dict = field(default_factory=dict)
     elevation_refraction: bool = False
+    station_displacement: object = None
 
     @classmethod
     def default(cls, **kw) -> "MeasurementSetup":
@@ -104,7 +107,9 @@ class MeasurementSetup:
 
     def station(self, name: str) -> StationNode:
         st = self.stations[name]
-        return StationNode(st.position_itrs, self.gcrs_to_itrs, self.ephemeris, self.origin, name)
+        disp, eph, rot = self.station_displacement, self.ephemeris, self.gcrs_to_itrs
+        position = st.position_itrs if disp is None else (lambda t: disp.position(st, t, eph, rot))
+        return StationNode(position, rot, eph, self.origin, name)
 
     def spacecraft(self, traj, name: str) -> SpacecraftNode:
         return SpacecraftNode(traj, self.ephemeris, self.origin, name)

@@ -239,6 +239,10 @@ class MeasurementsSection:
     # angle_el rows are apparent elevations: the free-space one bent by the ITU-R P.834 refraction at the
     # station's height
     elevation_refraction: bool = False
+    # stations displaced by the solid Earth tide (IERS 2010 §7.1.1; conventional tide free coordinates)
+    station_tides: bool = False
+    # BLQ ocean-loading coefficients: stations named like a site (or its part before '/') displaced (§7.1.2)
+    ocean_loading: Path | None = checked(readable_files, default=None)
 
 
 @dataclass

@@ -10,6 +10,7 @@ from odpipe.dynamics.propagator import propagate
 from odpipe.analysis.overlap import oem_trajectory
 from odpipe.environment.ephemeris import Ephemeris
 from odpipe.environment.gravity import read_gravity
+from odpipe.environment.station_displacement import StationDisplacement, sites_by_station
 from odpipe.environment.stations import StationCatalog
 from odpipe.estimation.registry import GaussMarkov
 from odpipe.frames.earth import gcrs_to_itrs
@@ -20,6 +21,7 @@ from odpipe.od.arc import ArcSetup, ManeuverPlan, sigma_value
 from odpipe.pipeline.config import RunConfig
 from odpipe.operations.schema import ConfigError
 from odpipe.time import utc_to_tdb
+from parsers import blq
 from parsers.maneuvers import read_plan
 
 
@@ -125,6 +127,14 @@ def initial_state(cfg: RunConfig) -> tuple[float, np.ndarray]:
         raise ConfigError(cfg.path, "initial_state.epoch", f"{init.epoch} is not covered by {init.from_oem}: {err}")
 
 
+def station_displacement(m) -> StationDisplacement | None:
+    """The configured station displacements (``[measurements] station_tides``, ``ocean_loading``), or None."""
+    if not m.station_tides and m.ocean_loading is None:
+        return None
+    sites = {} if m.ocean_loading is None else sites_by_station(blq.read(m.ocean_loading))
+    return StationDisplacement(m.station_tides, sites)
+
+
 def arc_setup(cfg: RunConfig, fm: F.ForceModel, ramps, catalog: StationCatalog) -> ArcSetup:
     est = cfg.estimation
     start, end = tdb(cfg.arc.start), tdb(cfg.arc.end)
@@ -136,7 +146,8 @@ def arc_setup(cfg: RunConfig, fm: F.ForceModel, ramps, catalog: StationCatalog) 
     # a fixed onboard range bias lengthens every range as a reflector that far behind the centre of mass would
     com = {cfg.arc.spacecraft: m.com_offset - m.onboard_range_bias} if m.com_offset or m.onboard_range_bias else {}
     meas = MeasurementSetup(fm.ephemeris, catalog, ramps=ramps, gcrs_to_itrs=gcrs_to_itrs, oscillators=oscillators,
-                            com_offsets=com, elevation_refraction=m.elevation_refraction)
+                            com_offsets=com, elevation_refraction=m.elevation_refraction,
+                            station_displacement=station_displacement(m))
     stochastic = None if est.stochastic is None else GaussMarkov(est.stochastic.tau, est.stochastic.sigma,
                                                                  est.stochastic.batch)
     return ArcSetup(spacecraft=cfg.arc.spacecraft, start=start, end=end, state0=state0, force_model=fm,
