@@ -18,8 +18,12 @@ _FIELD = re.compile(r"^\s+(\w+)\s*:")
 
 
 def field_comments(cls) -> dict[str, str]:
-    """Key -> the source comment describing it (same line, else the lines just above)."""
+    """Key -> the source comment describing it (same line, else the lines just above); inherited keys
+    described in their base classes."""
     out, above = {}, []
+    for base in reversed(cls.__mro__[1:]):
+        if dataclasses.is_dataclass(base):
+            out.update(field_comments(base))
     for line in inspect.getsource(cls).splitlines()[1:]:
         stripped = line.strip()
         if stripped.startswith("#"):

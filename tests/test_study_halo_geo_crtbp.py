@@ -1,17 +1,17 @@
 """Scenario 1 (Fujimoto et al. sec. 2.1): GEO + EML1 halo, crosslink range 1 m and
 range-rate 1 cm/s every 100 s. Paper: the position uncertainty of either satellite
-converges to about one metre within about eight days (values from runs/liaison_baseline.toml)."""
+converges to about one metre within about eight days (values from runs/study_halo_geo_crtbp.toml)."""
 
 from pathlib import Path
 
 import numpy as np
 import pandas as pd
 
-from odpipe.liaison.config import load_config
+from odpipe.studies.scenarios import load_config
 from odpipe.cli import main
-from odpipe.liaison.baseline import setup
+from odpipe.studies.halo_geo_crtbp import setup
 
-CONFIG = Path(__file__).parents[1] / "runs" / "liaison_baseline.toml"
+CONFIG = Path(__file__).parents[1] / "runs" / "study_halo_geo_crtbp.toml"
 CFG = load_config(CONFIG)
 DAY = 86400.0
 

@@ -23,9 +23,9 @@ from odpipe.analysis.montecarlo import monte_carlo, rms_over_runs, rss
 from odpipe.dynamics.crtbp import EarthMoonUnits
 
 from .crtbp_problem import RANGE, RANGE_RATE
-from .orbits import halo_by_period, keplerian_orbit
-from .pair import CrosslinkPair
-from .report import plot_convergence, write_markdown, write_table
+from .crtbp_orbits import halo_by_period, keplerian_orbit
+from .crosslink_pair import CrosslinkPair
+from .study_report import plot_convergence, write_markdown, write_table
 
 DAY = 86400.0
 SIDEREAL_DAY = 86164.0905

@@ -47,8 +47,8 @@ from odpipe.simulate.schedule import StateOnly, elevation
 from odpipe.time import utc_to_tdb
 from parsers.table import build
 
-from .doppler import link_clear
-from .report import plot_convergence, write_markdown, write_table
+from .halo_geo_doppler import link_clear
+from .study_report import plot_convergence, write_markdown, write_table
 
 DAY = 86400.0
 NAMES = ("L1", "GEO")

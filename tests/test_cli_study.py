@@ -7,7 +7,7 @@ from pathlib import Path
 
 import pytest
 
-import odpipe.liaison.baseline
+import odpipe.studies.halo_geo_crtbp
 from odpipe.cli import main
 
 RUNS = Path(__file__).resolve().parents[1] / "runs"
@@ -25,12 +25,12 @@ def scenario(monkeypatch):
         ran.append(cfg["seed"])
         (out / "report.md").write_text(f"seed {cfg['seed']}\n")
         return {}
-    monkeypatch.setattr(odpipe.liaison.baseline, "run", fake)
+    monkeypatch.setattr(odpipe.studies.halo_geo_crtbp, "run", fake)
     return ran
 
 
 def _configs(tmp_path, *seeds):
-    text = (RUNS / "liaison_baseline.toml").read_text()
+    text = (RUNS / "study_halo_geo_crtbp.toml").read_text()
     paths = []
     for s in seeds:
         p = tmp_path / f"liaison_{s}.toml"

@@ -6,16 +6,16 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from odpipe.liaison.config import load_config
+from odpipe.studies.scenarios import load_config
 from odpipe.dynamics.propagator import propagate
 from odpipe.estimation.fit import build_grid
 from odpipe.estimation.registry import ParameterRegistry
-from odpipe.liaison.doppler import NAMES, R_EARTH, _rows, force_models, link_clear
+from odpipe.studies.halo_geo_doppler import NAMES, R_EARTH, _rows, force_models, link_clear
 from odpipe.measurements import MeasurementSetup, compute
 from odpipe.od.problem import TrackingProblem
 from odpipe.time import utc_to_tdb
 
-CFG = load_config(Path(__file__).parents[1] / "runs" / "liaison_doppler.toml")
+CFG = load_config(Path(__file__).parents[1] / "runs" / "study_halo_geo_doppler.toml")
 
 
 def test_link_blocked_only_through_the_earth():

@@ -25,9 +25,9 @@ from odpipe.analysis.observability import gramian, observability_measures, snr_r
 from odpipe.dynamics.crtbp import jacobi_constant
 
 from .crtbp_problem import RANGE, RANGE_RATE, units_from_mu
-from .orbits import halo_by_period, halo_start, keplerian_orbit
-from .pair import CrosslinkPair
-from .report import plot_convergence, write_markdown, write_table
+from .crtbp_orbits import halo_by_period, halo_start, keplerian_orbit
+from .crosslink_pair import CrosslinkPair
+from .study_report import plot_convergence, write_markdown, write_table
 
 DAY = 86400.0
 TYPES = {"range": (RANGE,), "range-rate": (RANGE_RATE,)}

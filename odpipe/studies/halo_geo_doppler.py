@@ -33,7 +33,7 @@ from odpipe.od.problem import TrackingProblem
 from odpipe.time import utc_to_tdb
 from parsers.table import build
 
-from .report import plot_convergence, write_markdown, write_table
+from .study_report import plot_convergence, write_markdown, write_table
 
 DAY = 86400.0
 R_EARTH = 6378136.3

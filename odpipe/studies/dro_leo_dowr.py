@@ -52,8 +52,8 @@ from odpipe.od.problem import TrackingProblem
 from odpipe.time import utc_to_tdb
 from parsers.table import build
 
-from .doppler import link_clear
-from .report import plot_convergence, write_markdown, write_table
+from .halo_geo_doppler import link_clear
+from .study_report import plot_convergence, write_markdown, write_table
 
 DAY = 86400.0
 NAMES = ("DRO", "LEO")

@@ -1,6 +1,6 @@
 """Scenario 2 (Turan et al.): EML1 halo / lunar orbiter, range-only vs range-rate-only.
 
-Checks against the paper (values read from runs/liaison_turan.toml [paper.table1]):
+Checks against the paper (values read from runs/study_formation_observability.toml [paper.table1]):
 Table 1's Gramian measures of the four EML1/L2 formations (halos started at apolune, both
 north) within 2.5x of the paper's and Xi_mean of all 12 formations within 2x; Table 1's
 unobservability indices of the EML1/Lunar 2.78 TU formation lie inside
@@ -16,14 +16,14 @@ import numpy as np
 import pytest
 from scipy.stats import chi2
 
-from odpipe.liaison.config import load_config
+from odpipe.studies.scenarios import load_config
 from odpipe.analysis.montecarlo import monte_carlo
-from odpipe.liaison.crtbp_problem import RANGE, RANGE_RATE
-from odpipe.liaison.orbits import halo_by_period, keplerian_orbit
-from odpipe.liaison.pair import CrosslinkPair
-from odpipe.liaison.turan import formations, log_ratios, observability_row, orbits, units
+from odpipe.studies.crtbp_problem import RANGE, RANGE_RATE
+from odpipe.studies.crtbp_orbits import halo_by_period, keplerian_orbit
+from odpipe.studies.crosslink_pair import CrosslinkPair
+from odpipe.studies.formation_observability import formations, log_ratios, observability_row, orbits, units
 
-CFG = load_config(Path(__file__).parents[1] / "runs" / "liaison_turan.toml")
+CFG = load_config(Path(__file__).parents[1] / "runs" / "study_formation_observability.toml")
 COLUMN = 4                                           # EML1/Lunar, halo period 2.78 TU
 DAY = 86400.0
 

@@ -6,15 +6,15 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from odpipe.liaison.config import load_config
+from odpipe.studies.scenarios import load_config
 from odpipe.dynamics.propagator import propagate
 from odpipe.environment.ephemeris import Ephemeris
 from odpipe.environment.stations import itrs_to_geodetic
 from odpipe.frames.earth import gcrs_to_itrs_state
-from odpipe.liaison import ground
+from odpipe.studies import ground_and_crosslink as ground
 from odpipe.time import utc_to_tdb
 
-CFG = load_config(Path(__file__).parents[1] / "runs" / "liaison_ground.toml")
+CFG = load_config(Path(__file__).parents[1] / "runs" / "study_ground_and_crosslink.toml")
 CASES = ("ground", "ground_liaison")          # (inf, 0) and (0, 0) of the thesis' Fig. 8.4/8.5
 
 
@@ -108,9 +108,9 @@ def test_schedule_mesh_and_offset(tmp_path):
     """Fig. 8.4 corners and Fig. 8.9 at a 22-h gap: both data types beat either alone for both
     spacecraft; offsetting the ground passes by half the gap changes the 3-sigma by < 25 % (thesis:
     "neither satellite's uncertainty or accuracy is impacted significantly")."""
-    from odpipe.liaison import ground_mesh
+    from odpipe.studies import schedule_trade
 
-    cfg = load_config(Path(__file__).parents[1] / "runs" / "liaison_ground_mesh.toml")
+    cfg = load_config(Path(__file__).parents[1] / "runs" / "study_schedule_trade.toml")
     cfg = dict(cfg, mesh={"gaps_h": [0.0, np.inf]}, offset={"gaps_h": [22.0]})
     res = ground_mesh.run(cfg, tmp_path, log=lambda m: None)
     mesh = res["mesh"].set_index(["liaison_gap_h", "ground_gap_h"])

@@ -7,11 +7,11 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from odpipe.liaison.config import load_config
+from odpipe.studies.scenarios import load_config
 from odpipe.dynamics.forces import AtmosphericDrag, ForceModel, PointMasses, SolarRadiationPressure
 from odpipe.dynamics.propagator import propagate
 from odpipe.estimation.registry import ParameterRegistry
-from odpipe.liaison import dowr
+from odpipe.studies import dro_leo_dowr as dowr
 from odpipe.measurements import MeasurementSetup
 from odpipe.measurements.bands import C_LIGHT
 from odpipe.measurements.crosslink import ClockModel, one_way_pseudorange
@@ -20,7 +20,7 @@ from odpipe.measurements.nodes import SpacecraftNode
 from odpipe.time import utc_to_tdb
 
 ROOT = Path(__file__).resolve().parents[1]
-CFG = load_config(ROOT / "runs/liaison_dowr.toml")
+CFG = load_config(ROOT / "runs/study_dro_leo_dowr.toml")
 EPOCH = np.datetime64(CFG["epoch_utc"], "ns")
 T0 = float(utc_to_tdb(EPOCH))
 
@@ -110,7 +110,7 @@ def test_reduced_run_dowr_clock_and_mode_ordering(shared_data, tmp_path):
     """Three days, the true dynamics (Model-A, fields cut to degree 20 for speed), DOWR (Simu. 6) against
     one-way ranging (the Simu. 8 link plan): Table 13's ordering (one-way 7x worse on the clock and
     20-240x on the DRO position), the LEO converging first (Simu. 6: 2 days), the clock below 100 ns
-    (sec. 5.4.3). (Table 13's 40-day figures themselves need the full run: runs/liaison_dowr.toml.)"""
+    (sec. 5.4.3). (Table 13's 40-day figures themselves need the full run: runs/study_dro_leo_dowr.toml.)"""
     cfg = dict(CFG, arc_days=3.0, last_days=1.0, stage_days=[0.5], max_iter=4, final_iter=2,
                earth_gravity=str(shared_data / "gravity/tudat/ggm02c.txt"),
                moon_gravity=str(shared_data / "gravity/gmat/LP165P.cof"))
