@@ -29,3 +29,9 @@ def run_study(config: str) -> dict:
     cfg = load_config(RUNS / f"{config}.toml")
     out = Path(tempfile.mkdtemp(prefix=f"{config}_"))
     return importlib.import_module(f"odpipe.studies.{cfg['scenario']}").run(cfg, out, log=lambda m: None)
+
+
+def as_recorded(text: str):
+    """A figure as docs/validation.md records it (e.g. "7.85"): equal to within half a unit of its last digit."""
+    decimals = len(text.split(".")[1]) if "." in text else 0
+    return pytest.approx(float(text), abs=0.5 * 10.0 ** -decimals)

@@ -1,21 +1,45 @@
-"""Scenario 4 (Leonard's thesis sec. 8.1): an EML1 halo orbiter and a GEO satellite tracked from
-the ground alone and from the ground plus LiAISON; the thesis' figures as references."""
+"""Study ground_and_crosslink (Leonard 2015, sec. 8.1) and its trade study schedule_trade (secs.
+8.1.2.3-8.1.2.4): an EML1 halo orbiter and a GEO satellite tracked from the ground alone, by crosslinks
+alone and by both.
+
+The thesis' figures (runs/study_ground_and_crosslink.toml [paper], read from the text of sec. 8.1.2.3) are
+checked against odpipe's with the tolerance the text allows, or recorded as disagreements where odpipe
+does not agree; odpipe's own figures are snapshots (relative 1e-3: the run is seeded). The default suite
+fits three schedules (ground only, crosslinks only, both) and the 22-h offset pair on one shared set-up;
+the other schedules need the whole run (``ODPIPE_STUDY_RUNS=1``, tests/study_runs.py).
+
+Tolerance for agreement: a factor 2. The thesis quotes rounded figures ("about 70 m", "on the order of
+10 m") and does not give the correlation time of its empirical accelerations; odpipe takes 1 day, and
+with 3 h the ground-only halo figure moves to 0.44x of the thesis', outside the bound: the agreement
+depends on that choice."""
 
 from pathlib import Path
 
 import numpy as np
 import pytest
+from scipy.stats import chi2
 
-from odpipe.studies.scenarios import load_config
 from odpipe.dynamics.propagator import propagate
 from odpipe.environment.ephemeris import Ephemeris
 from odpipe.environment.stations import itrs_to_geodetic
 from odpipe.frames.earth import gcrs_to_itrs_state
 from odpipe.studies import ground_and_crosslink as ground
+from odpipe.studies import schedule_trade
+from odpipe.studies.scenarios import load_config
 from odpipe.time import utc_to_tdb
+from study_runs import as_recorded, run_study, whole_run
 
 CFG = load_config(Path(__file__).parents[1] / "runs" / "study_ground_and_crosslink.toml")
-CASES = ("ground", "ground_liaison")          # (inf, 0) and (0, 0) of the thesis' Fig. 8.4/8.5
+CASES = ("ground", "ground_liaison", "liaison")   # (inf, 0), (0, 0) and (0, inf) of the thesis' Fig. 8.4/8.5
+# odpipe's figures (m, d), recorded 2026-11-25: 3-D 3-sigma RMS over days 6-9, final 3-sigma, day below 100 m
+RECORDED = {
+    ("ground", "L1"): {"rms_sig3": RMS_GROUND_L1, "final_sig3": FINAL_GROUND_L1},
+    ("ground", "GEO"): {"rms_sig3": RMS_GROUND_GEO, "final_sig3": FINAL_GROUND_GEO},
+    ("ground_liaison", "L1"): {"rms_sig3": RMS_BOTH_L1, "final_sig3": FINAL_BOTH_L1},
+    ("ground_liaison", "GEO"): {"rms_sig3": RMS_BOTH_GEO, "final_sig3": FINAL_BOTH_GEO},
+    ("liaison", "L1"): {"rms_sig3": RMS_LIAISON_L1, "final_sig3": FINAL_LIAISON_L1},
+    ("liaison", "GEO"): {"rms_sig3": RMS_LIAISON_GEO, "final_sig3": FINAL_LIAISON_GEO},
+}
 
 
 def test_schedule_of_passes_and_gaps():
@@ -58,13 +82,62 @@ def test_geo_satellite_stays_over_the_thesis_longitude():
 
 @pytest.fixture(scope="module")
 def scenario(tmp_path_factory):
+    """The study on CASES (no sensitivity refits), its set-up kept for the trade study's test."""
     cfg = dict(CFG, cases={k: CFG["cases"][k] for k in CASES}, sensitivity=dict(CFG["sensitivity"], cases=[]))
-    return ground.run(cfg, tmp_path_factory.mktemp("liaison_ground"), log=lambda m: None)
+    return ground.run(cfg, tmp_path_factory.mktemp("study_ground"), log=lambda m: None)
 
 
 def _row(scenario, case, sc):
     df = scenario["table"]
     return df[(df["case"] == case) & (df["spacecraft"] == sc)].iloc[0]
+
+
+def _figures(row) -> dict:
+    return {"rms_sig3": row["odpipe 3s RMS d6-9"], "final_sig3": row["odpipe final 3s"],
+            "below100_d": row["odpipe day 3s<100 m"]}
+
+
+@pytest.mark.realdata
+def test_snapshot_of_three_schedules(scenario):
+    """odpipe's 3-sigma figures of ground only, both and crosslinks only, relative 1e-3."""
+    for (case, sc), recorded in RECORDED.items():
+        got = _figures(_row(scenario, case, sc))
+        for key, value in recorded.items():
+            assert got[key] == pytest.approx(value, rel=1e-3), (case, sc, key)
+
+
+@pytest.mark.realdata
+def test_ground_and_both_against_the_thesis(scenario):
+    """Agreement within a factor 2 (module docstring): ground only, halo over days 6-9 (thesis about 70 m, odpipe
+    36 m: 0.51x); ground + crosslinks, final halo and GEO (thesis "on the order of" 10 m and 3 m, odpipe 18 m and
+    2.9 m). And the thesis' ordering: both data types beat ground alone for each spacecraft."""
+    paper = CFG["paper"]
+    g_l1, g_geo = _row(scenario, "ground", "L1"), _row(scenario, "ground", "GEO")
+    b_l1, b_geo = _row(scenario, "ground_liaison", "L1"), _row(scenario, "ground_liaison", "GEO")
+    assert 0.5 < g_l1["odpipe 3s RMS d6-9"] / paper["ground"]["L1_rms_sig3"] < 2.0
+    assert 0.5 < b_l1["odpipe final 3s"] / paper["ground_liaison"]["L1_final_sig3"] < 2.0
+    assert 0.5 < b_geo["odpipe final 3s"] / paper["ground_liaison"]["GEO_final_sig3"] < 2.0
+    assert b_l1["odpipe 3s RMS d6-9"] < 0.7 * g_l1["odpipe 3s RMS d6-9"]
+    assert b_geo["odpipe 3s RMS d6-9"] < 0.05 * g_geo["odpipe 3s RMS d6-9"]
+    assert b_geo["odpipe error RMS d6-9"] < 0.1 * g_geo["odpipe error RMS d6-9"]
+
+
+@pytest.mark.realdata
+def test_disagreements_with_the_thesis_as_they_are(scenario):
+    """Where odpipe does NOT agree with the thesis, recorded as it is (the snapshot test holds the values):
+
+    - GEO from Sky Valley alone: the thesis says its a priori uncertainty is not reduced (the colour of Fig. 8.4
+      saturates above 150 m). odpipe shrinks the a priori 3-sigma (3-D, 5.2 km) about 15x, to 351 m over days
+      6-9: still above 150 m, so the figure's colour agrees, the statement does not. The cause is not found.
+    - Crosslinks only: thesis about 160 m (halo) and 24 m (GEO); odpipe about 3x tighter (50 m and 8 m)."""
+    paper, apriori_3d = CFG["paper"], 3 * np.sqrt(3) * CFG["filter"]["apriori_pos_m"]
+    geo = _row(scenario, "ground", "GEO")["odpipe 3s RMS d6-9"]
+    assert geo > 150.0 and apriori_3d / geo == pytest.approx(apriori_3d / RMS_GROUND_GEO, rel=1e-3)
+    for sc in ground.NAMES:
+        ratio = _row(scenario, "liaison", sc)["odpipe 3s RMS d6-9"] / paper["liaison"][f"{sc}_rms_sig3"]
+        assert ratio == pytest.approx(RECORDED[("liaison", sc)]["rms_sig3"] / paper["liaison"][f"{sc}_rms_sig3"],
+                                      rel=1e-3)
+        assert ratio < 0.5
 
 
 @pytest.mark.realdata
@@ -78,45 +151,85 @@ def test_truth_within_the_reported_covariance(scenario, case):
         assert m[sc]["err"][-1] < m[sc]["sig3"][-1]
         i = reg.slice("state", sc)
         e = sol.smoothed_x[0, i] - scenario["x0"][sc]
-        assert e @ np.linalg.solve(sol.smoothed_P[0, i, i], e) < 22.5    # chi-square, 6 dof, 99.9 %
+        assert e @ np.linalg.solve(sol.smoothed_P[0, i, i], e) < chi2.ppf(0.999, 6)
     observed = ground.observed_biases(CFG, res["rows"])
-    assert len(observed) == (5 if case == "ground_liaison" else 4)       # 3 DSN, Sky Valley (+ crosslink)
+    assert len(observed) == {"ground_liaison": 5, "ground": 4, "liaison": 1}[case]   # 3 DSN, Sky Valley, crosslink
     for name in observed:
         k = reg.index(name)
         assert abs(sol.smoothed_x[0, k] - res["rows"].attrs["bias"][name]) < 3.0 * np.sqrt(sol.smoothed_P[0, k, k])
 
 
 @pytest.mark.realdata
-def test_liaison_improves_on_ground_tracking_as_the_thesis_says(scenario):
-    """Thesis: continuous ground tracking gives the halo about 70 m (3-sigma, RMS days 6-9) and leaves
-    the GEO satellite near its a priori (> 150 m in Fig. 8.4); adding continuous LiAISON ends at about
-    10 m and 3 m (Fig. 8.5). odpipe within a factor 2 of each quoted figure."""
-    paper = CFG["paper"]
-    g_l1, g_geo = _row(scenario, "ground", "L1"), _row(scenario, "ground", "GEO")
-    b_l1, b_geo = _row(scenario, "ground_liaison", "L1"), _row(scenario, "ground_liaison", "GEO")
-    assert 0.5 < g_l1["odpipe 3s RMS d6-9"] / paper["ground"]["L1_rms_sig3"] < 2.0
-    assert g_geo["odpipe 3s RMS d6-9"] > 150.0
-    assert 0.5 < b_l1["odpipe final 3s"] / paper["ground_liaison"]["L1_final_sig3"] < 2.0
-    assert 0.5 < b_geo["odpipe final 3s"] / paper["ground_liaison"]["GEO_final_sig3"] < 2.0
-    assert b_l1["odpipe 3s RMS d6-9"] < 0.7 * g_l1["odpipe 3s RMS d6-9"]
-    assert b_geo["odpipe 3s RMS d6-9"] < 0.05 * g_geo["odpipe 3s RMS d6-9"]
-    assert b_geo["odpipe error RMS d6-9"] < 0.1 * g_geo["odpipe error RMS d6-9"]
-
-
-@pytest.mark.realdata
-def test_schedule_mesh_and_offset(tmp_path):
-    """Fig. 8.4 corners and Fig. 8.9 at a 22-h gap: both data types beat either alone for both
-    spacecraft; offsetting the ground passes by half the gap changes the 3-sigma by < 25 % (thesis:
-    "neither satellite's uncertainty or accuracy is impacted significantly")."""
-    from odpipe.studies import schedule_trade
-
+def test_schedule_trade_corners_and_offset(scenario, tmp_path):
+    """Fig. 8.4 corners and Fig. 8.9 at a 22-h gap, on the same set-up (its fits shared): both data types beat
+    either alone for both spacecraft; offsetting the ground passes by half the gap changes the 3-sigma by
+    < 25 % (thesis: "neither satellite's uncertainty or accuracy is impacted significantly")."""
     cfg = load_config(Path(__file__).parents[1] / "runs" / "study_schedule_trade.toml")
+    setup_keys = set(CFG) - {"scenario", "cases", "paper", "report", "sensitivity"}
+    assert {k: cfg[k] for k in setup_keys} == {k: CFG[k] for k in setup_keys}     # the set-up is the same
     cfg = dict(cfg, mesh={"gaps_h": [0.0, np.inf]}, offset={"gaps_h": [22.0]})
-    res = ground_mesh.run(cfg, tmp_path, log=lambda m: None)
+    res = schedule_trade.run(cfg, tmp_path, log=lambda m: None, sim=scenario["sim"])
     mesh = res["mesh"].set_index(["liaison_gap_h", "ground_gap_h"])
     for sc in ground.NAMES:
         both = mesh.loc[(0.0, 0.0), f"{sc} rms_sig3"]
         assert both < mesh.loc[(0.0, np.inf), f"{sc} rms_sig3"] and both < mesh.loc[(np.inf, 0.0), f"{sc} rms_sig3"]
+        assert both == pytest.approx(RECORDED[("ground_liaison", sc)]["rms_sig3"], rel=1e-3)
     assert np.all(np.abs(res["ratio"].to_numpy() - 1.0) < 0.25)
     for name in ("report.md", "mesh.png", "offset.png", "mesh.csv", "offset_ratio.csv"):
         assert (tmp_path / name).stat().st_size > 0
+
+
+# odpipe's figures of the whole runs as docs/validation.md records them (seeded): case -> (L1, GEO) 3-D 3-sigma
+# RMS over days 6-9 (m), or the day after which it stays below 100 m
+WHOLE_RMS = {"liaison_2_per_day_ground_69": ("50.0", "9.3"), "sparse": ("76", "21")}
+WHOLE_BELOW100 = {"ground_liaison_72": ("3.6", "3.1")}
+
+
+@whole_run
+@pytest.mark.realdata
+def test_whole_run_other_schedules_against_the_thesis():
+    """The schedules the default suite does not fit. Agreement within a factor 2 (module docstring): LiAISON twice a
+    day + ground every 3 days (thesis about 50/10 m), the sparse (28, 49) region (about 110/35 m), (72, 0) below
+    100 m from day 3/3; snapshots to the recorded digits. The Table 8.3 accelerations tripled bring crosslinks
+    only to 125/18.6 m (thesis 160/24): the disagreement above is the noise model's choice."""
+    table = run_study("study_ground_and_crosslink")["table"]
+    row = {(r["case"], r["spacecraft"]): r for _, r in table.iterrows()}
+    paper = CFG["paper"]
+    for case, recorded in WHOLE_RMS.items():
+        for sc, text in zip(ground.NAMES, recorded):
+            got = row[(case, sc)]["odpipe 3s RMS d6-9"]
+            assert got == as_recorded(text) and 0.5 < got / paper[case][f"{sc}_rms_sig3"] < 2.0, (case, sc)
+    for case, recorded in WHOLE_BELOW100.items():
+        for sc, text in zip(ground.NAMES, recorded):
+            got = row[(case, sc)]["odpipe day 3s<100 m"]
+            assert got == as_recorded(text) and 0.5 < got / paper[case][f"{sc}_below100_d"] < 2.0, (case, sc)
+    for sc, text in zip(ground.NAMES, ("125", "18.6")):
+        assert row[("liaison (acc x3)", sc)]["odpipe 3s RMS d6-9"] == as_recorded(text)
+
+
+@whole_run
+@pytest.mark.realdata
+def test_whole_run_schedule_trade():
+    """The Fig. 8.4 mesh and the Fig. 8.9 offset study, recorded figures: GEO needs the crosslinks (351-714 m from
+    ground alone, 4-73 m with them); crosslinks once a day alone keep the halo at 148 m; offsetting the ground
+    passes changes the 3-sigma by 0.88-1.27x at gaps of 6-60 h (thesis: not significantly), but 0.29x for the
+    halo at 72 h, where the offset puts a ground pass inside the day 6-9 window; the diagonal's local peaks (the
+    thesis' resonances) at 22 h for the halo (60 m against 45 m at 18 h and 53 m at 26 h) and 44 h for GEO
+    (35 m against 19 and 28 m)."""
+    res = run_study("study_schedule_trade")
+    mesh = res["mesh"].set_index(["liaison_gap_h", "ground_gap_h"])
+    ground_only = mesh.xs(np.inf, level="liaison_gap_h")["GEO rms_sig3"]
+    with_crosslinks = mesh.loc[[k for k in mesh.index if np.isfinite(k[0])], "GEO rms_sig3"]
+    assert (ground_only.min(), ground_only.max()) == (as_recorded("351"), as_recorded("714"))
+    assert (with_crosslinks.min(), with_crosslinks.max()) == (as_recorded("4"), as_recorded("73"))
+    assert mesh.loc[(22.0, np.inf), "L1 rms_sig3"] == as_recorded("148")
+    ratio = res["ratio"]
+    mid = ratio.loc[(ratio.index >= 6) & (ratio.index <= 60)].to_numpy()
+    assert (mid.min(), mid.max()) == (as_recorded("0.88"), as_recorded("1.27"))
+    assert ratio.loc[72.0, "L1 rms_sig3"] == as_recorded("0.29")
+    diagonal = res["offset"][res["offset"].ground_offset_h == 0].set_index("liaison_gap_h")
+    for sc, peak, sides in (("L1", 22.0, (18.0, 26.0)), ("GEO", 44.0, (36.0, 48.0))):
+        values = diagonal[f"{sc} rms_sig3"]
+        assert values[peak] > max(values[s] for s in sides)
+    assert [diagonal["L1 rms_sig3"][g] for g in (18.0, 22.0, 26.0)] == [as_recorded(t) for t in ("45", "60", "53")]
+    assert [diagonal["GEO rms_sig3"][g] for g in (36.0, 44.0, 48.0)] == [as_recorded(t) for t in ("19", "35", "28")]

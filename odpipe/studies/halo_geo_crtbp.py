@@ -1,4 +1,4 @@
-"""Scenario 1 (seed 000, Fujimoto et al. sec. 2.1): GEO + Earth-Moon L1 halo in the CRTBP.
+"""An L1 halo and a GEO satellite tracked only by each other in the CRTBP (seed 000, Fujimoto et al. sec. 2.1).
 
 Instantaneous crosslink range (1 m) and range-rate (1 cm/s) every 100 s; a priori
 100 m / 1 cm/s per axis; initial deviations of 100 m and 1 cm/s (the paper's Table 3
@@ -129,7 +129,7 @@ def run(cfg: dict, out, log=print) -> dict:
                         f"{pair.epochs.size} epochs of range and range-rate.\n"),
                 (f"Sensitivity to the unspecified set-up (CRLB at day {day}, paper: about 1 m)",
                  write_table(out, "sensitivity", sensitivity(cfg)))]
-    write_markdown(out, "LiAISON scenario 1: GEO + EML1 halo, CRTBP baseline (Fujimoto et al. sec. 2.1)", sections)
+    write_markdown(out, "Study halo_geo_crtbp: GEO + EML1 halo in the CRTBP (Fujimoto et al. sec. 2.1)", sections)
     for r in rows:
         log(f"{r['spacecraft']}: {r['quantity']}: paper {r['paper']}, odpipe {r['odpipe']:.4g}")
     return {"table": table}

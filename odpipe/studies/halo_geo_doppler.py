@@ -1,5 +1,5 @@
-"""Scenario 1b (seed 000, Fujimoto et al. secs. 3-4): GEO + EML1 halo, two-way crosslink Doppler,
-high-fidelity dynamics.
+"""An L1 halo and a GEO satellite with two-way crosslink Doppler and high-fidelity dynamics (seed 000,
+Fujimoto et al. secs. 3-4).
 
 Truth: Earth-centred ICRF states of Table 1 at 2020-01-01 (UTC), point masses of the
 Sun, Moon and planets (DE440; the paper: DE405) and a 20x20 Earth field on the GEO
@@ -150,7 +150,7 @@ def run(cfg: dict, out, log=print) -> dict:
                       f"{clear.size} epochs tracked (link clear of the Earth, GEO |v_x| >= "
                       f"{cfg['filter'].get('geo_cutoff_vx_mps', 0.0)} m/s), converged {r['converged']}"
                       for band, r in results.items())
-    write_markdown(out, "LiAISON scenario 1b: GEO + EML1 halo, two-way crosslink Doppler (Fujimoto et al. secs. 3-4)",
+    write_markdown(out, "Study halo_geo_doppler: GEO + EML1 halo, two-way crosslink Doppler (Fujimoto et al. secs. 3-4)",
                    [("Tables 4-5: accuracy RMS over the last half, paper vs odpipe",
                      write_table(out, "tables45", table) + "\n![convergence](convergence.png)\n"),
                     ("Fit", notes + "\n"), ("Differences from the paper's set-up", DIFFERENCES)])

@@ -1,4 +1,4 @@
-"""Scenario 4, trade study (Leonard's thesis secs. 8.1.2.3-8.1.2.4): the Fig. 8.4 mesh of
+"""The tracking-schedule trade study (Leonard 2015, secs. 8.1.2.3-8.1.2.4): the Fig. 8.4 mesh of
 (LiAISON gap, ground gap) schedules and the Fig. 8.9 scheduling offset, on the set-up of
 :mod:`.ground_and_crosslink` (same truth, data, noise and filter).
 
@@ -59,8 +59,10 @@ def plot_mesh(out: Path, df: pd.DataFrame, gaps) -> Path:
     return path
 
 
-def run(cfg: dict, out, log=print) -> dict:
-    sim = prepare(cfg, log)
+def run(cfg: dict, out, log=print, sim: dict | None = None) -> dict:
+    """The mesh and the offset study on ``sim`` (a :func:`prepare` of this set-up; made when None); writes
+    report.md, the tables and plots into ``out``."""
+    sim = sim or prepare(cfg, log)
     gaps = [float(g) for g in cfg["mesh"]["gaps_h"]]
     mesh = []
     for lg in gaps:
@@ -101,6 +103,6 @@ def run(cfg: dict, out, log=print) -> dict:
          + "\n" + write_table(out, "offset", offset[cols + ["ground_offset_h", "converged"]])),
         ("Set-up", "As `study_ground_and_crosslink.toml` (see its report for the differences from the thesis); the "
                    "x-axis of the offset plot is the gap in hours.\n")]
-    write_markdown(out, "LiAISON scenario 4: tracking-schedule trade study (Leonard thesis secs. 8.1.2.3-8.1.2.4)",
+    write_markdown(out, "Study schedule_trade: tracking-schedule trade study (Leonard thesis secs. 8.1.2.3-8.1.2.4)",
                    sections)
     return {"mesh": mesh, "offset": offset, "ratio": ratio}
