@@ -103,8 +103,6 @@ class MonteCarlo:
     runs: int = checked(_at_least_zero, default=0)  # number of runs (0: none)
     seed: int = 0  # seed of the runs' draws
     parallel: bool = False  # on a local Dask cluster
-    workers: int | None = None  # Dask workers (default: one per core)
-    columns: list[int] = field(default_factory=list)  # formations (Table 1 column index) to run
 
 
 # --- halo_geo_crtbp: Fujimoto et al. sec. 2.1 ---------------------------------------------------------
@@ -259,6 +257,14 @@ class FormationPaper:
 
 
 @section
+class FormationMonteCarlo(MonteCarlo):
+    """Monte Carlo runs of the fit on some formations."""
+
+    workers: int | None = None  # Dask workers (default: one per core)
+    columns: list[int]  # formations (Table 1 column index, from 0) to run
+
+
+@section
 class FormationObservability(Scenario):
     """``scenario = "formation_observability"``: range-only against range-rate-only crosslinks in halo/halo
     and halo/lunar-orbiter formations (Turan et al. 2022, Table 1, Figs. 4-5)."""
@@ -269,7 +275,7 @@ class FormationObservability(Scenario):
     filter: FormationFilter
     halo: FormationHalos
     lunar: LunarOrbiter
-    montecarlo: MonteCarlo
+    montecarlo: FormationMonteCarlo
     sweep: Sweep
     paper: FormationPaper
 
