@@ -20,7 +20,7 @@ from odpipe.dynamics.forces import ForceModel, PointMasses, SphericalHarmonics
 from odpipe.dynamics.propagator import propagate
 from odpipe.environment.ephemeris import Ephemeris
 from odpipe.environment.gravity import read_gravity
-from odpipe.liaison.dowr import circular_state
+from odpipe.studies.dro_leo_dowr import circular_state
 from odpipe.time import utc_to_tdb
 
 DATA = Path(os.environ.get("ODPIPE_SHARED_DATA", Path(__file__).resolve().parents[2] / "shared" / "data"))

@@ -1,7 +1,7 @@
 """LiAISON baseline in the Earth-Moon CRTBP (seed 000, section 2.1).
 
-A spacecraft in an Earth-Moon L1 halo (odpipe.liaison.orbits.correct_halo) and
-one at GEO, tracked only by each other (odpipe.liaison.crtbp_problem.CrosslinkProblem):
+A spacecraft in an Earth-Moon L1 halo (odpipe.studies.crtbp_orbits.correct_halo) and
+one at GEO, tracked only by each other (odpipe.studies.crtbp_problem.CrosslinkProblem):
 instantaneous relative range (1 m) and range-rate (1 cm/s) every 100 s. A priori 100 m / 1 cm/s per axis for both, truth
 drawn from it. Dynamics: odpipe.dynamics.crtbp (GM Earth 398,600.4415 km^3/s^2,
 Moon 4,902.80 km^3/s^2). The paper's state-noise compensation (1e-13 and
@@ -17,8 +17,8 @@ from scipy.stats import chi2
 from odpipe.dynamics.crtbp import EarthMoonUnits, propagate_crtbp
 from odpipe.estimation.fit import FitOptions, Observations, fit
 from odpipe.estimation.registry import ParameterRegistry
-from odpipe.liaison.crtbp_problem import CrosslinkProblem, crosslink_rows
-from odpipe.liaison.orbits import correct_halo
+from odpipe.studies.crtbp_problem import CrosslinkProblem, crosslink_rows
+from odpipe.studies.crtbp_orbits import correct_halo
 
 U = EarthMoonUnits(gm1=3.986004415e14, gm2=4.90280e12)
 MU, T, L = U.mu, U.time, U.length

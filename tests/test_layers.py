@@ -4,8 +4,11 @@
 bottom: every layer may import it and it imports no odpipe but ``BENEATH``, the constants under
 everything (odpipe.constants), which import nothing of the project. Every ``import`` counts, also
 those inside functions and under ``TYPE_CHECKING``; imports by name through ``importlib``
-(the CLI finding its commands, ``commands.liaison`` its scenario) are not seen. Each
+(the CLI finding its commands, ``commands.study`` its scenario) are not seen. Each
 package of odpipe must be placed, so a new package cannot slip in without a layer.
+
+The studies (``odpipe.studies``, the seed papers' scenarios) sit above the library: only the
+commands may import them, so nothing the library does can depend on a reproduction.
 """
 
 from __future__ import annotations
@@ -34,7 +37,8 @@ LAYERS = (
     ("estimation", ("odpipe.estimation",)),
     ("orbit determination and analysis", ("odpipe.od", "odpipe.analysis")),
     ("products and run bookkeeping", ("odpipe.products", "odpipe.operations")),
-    ("pipeline, simulator and studies", ("odpipe.pipeline", "odpipe.simulate", "odpipe.liaison")),
+    ("pipeline and simulator", ("odpipe.pipeline", "odpipe.simulate")),
+    ("studies", ("odpipe.studies",)),
     ("commands", ("odpipe.commands", "odpipe.cli", "odpipe.api")),
 )
 
@@ -118,6 +122,18 @@ def test_every_import_runs_down_the_layers():
     for p in source_files():
         found += violations(module_name(p), str(p.relative_to(ROOT)), p.read_text(), p.name == "__init__.py")
     assert not found, "imports against the pipeline's flow:\n" + "\n".join(found)
+
+
+def test_the_library_never_imports_the_studies():
+    """Only the commands import ``odpipe.studies``: ``odpipe study`` (and its former name) and ``odpipe reference``."""
+    found = [f"{p.relative_to(ROOT)}:{line}: imports {target}"
+             for p in source_files() if not module_name(p).startswith(("odpipe.studies", "odpipe.commands."))
+             for line, target in imports(p.read_text(), module_name(p), p.name == "__init__.py")
+             if target == "odpipe.studies" or target.startswith("odpipe.studies.")]
+    assert found == []
+    users = {module_name(p) for p in source_files() if module_name(p).startswith("odpipe.commands.")
+             and any(t.startswith("odpipe.studies") for _, t in imports(p.read_text(), module_name(p), False))}
+    assert users == {"odpipe.commands.study", "odpipe.commands.reference"}
 
 
 def test_every_package_has_a_layer():

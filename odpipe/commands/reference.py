@@ -1,13 +1,13 @@
 """``odpipe reference``: the configuration reference (every key, type, default, meaning) as Markdown.
 
-One document for every kind of configuration file: run configurations, then simulated cases.
+One document for every kind of configuration file: run configurations, simulated cases, studies.
 ``docs/config.md`` is its output.
 """
 
 from __future__ import annotations
 
 NAME = "reference"
-HELP = "print the configuration reference (run configurations, simulated cases: every key, type, unit, default)"
+HELP = "print the configuration reference (run configurations, simulated cases, studies: every key, type, unit, default)"
 
 
 def add_arguments(parser) -> None:
@@ -18,8 +18,9 @@ def document() -> str:
     """The reference of every configuration kind, one Markdown document."""
     from odpipe.pipeline.config import reference as run_reference
     from odpipe.simulate.case import reference as case_reference
+    from odpipe.studies import scenarios
 
-    return run_reference() + "\n" + case_reference()
+    return run_reference() + "\n" + case_reference() + "\n" + scenarios.reference()
 
 
 def run(args) -> int:

@@ -8,6 +8,7 @@ its class docstring. ``odpipe reference`` prints the Markdown; ``docs/config.md`
 from __future__ import annotations
 
 import dataclasses
+import functools
 import inspect
 import re
 import types
@@ -17,9 +18,14 @@ from pathlib import Path
 _FIELD = re.compile(r"^\s+(\w+)\s*:")
 
 
+@functools.cache
 def field_comments(cls) -> dict[str, str]:
-    """Key -> the source comment describing it (same line, else the lines just above)."""
+    """Key -> the source comment describing it (same line, else the lines just above); inherited keys
+    described in their base classes."""
     out, above = {}, []
+    for base in reversed(cls.__mro__[1:]):
+        if dataclasses.is_dataclass(base):
+            out.update(field_comments(base))
     for line in inspect.getsource(cls).splitlines()[1:]:
         stripped = line.strip()
         if stripped.startswith("#"):

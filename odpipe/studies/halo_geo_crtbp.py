@@ -1,4 +1,4 @@
-"""Scenario 1 (seed 000, Fujimoto et al. sec. 2.1): GEO + Earth-Moon L1 halo in the CRTBP.
+"""An L1 halo and a GEO satellite tracked only by each other in the CRTBP (seed 000, Fujimoto et al. sec. 2.1).
 
 Instantaneous crosslink range (1 m) and range-rate (1 cm/s) every 100 s; a priori
 100 m / 1 cm/s per axis; initial deviations of 100 m and 1 cm/s (the paper's Table 3
@@ -19,15 +19,16 @@ from dataclasses import replace
 import numpy as np
 import pandas as pd
 
+from odpipe.constants import SECONDS_PER_DAY
 from odpipe.analysis.montecarlo import monte_carlo, rms_over_runs, rss
 from odpipe.dynamics.crtbp import EarthMoonUnits
 
 from .crtbp_problem import RANGE, RANGE_RATE
-from .orbits import halo_by_period, keplerian_orbit
-from .pair import CrosslinkPair
-from .report import plot_convergence, write_markdown, write_table
+from .crtbp_orbits import halo_by_period, keplerian_orbit
+from .crosslink_pair import CrosslinkPair
+from .study_report import plot_convergence, write_markdown, write_table
 
-DAY = 86400.0
+DAY = SECONDS_PER_DAY
 SIDEREAL_DAY = 86164.0905
 
 
@@ -124,12 +125,12 @@ def run(cfg: dict, out, log=print) -> dict:
                 curves.append((f"MC RMS ({n_mc} runs)", rss(curves_mc, c), {"color": "C1"}))
             panels.append({"title": f"{sc} {what} ({unit})", "t_days": t / DAY, "curves": curves})
     plot_convergence(out, "convergence", panels, "error / sigma")
-    sections = [("Paper vs odpipe", write_table(out, "baseline", table) + "\n![convergence](convergence.png)\n"),
+    sections = [("Paper vs odpipe", write_table(out, "halo_geo_crtbp", table) + "\n![convergence](convergence.png)\n"),
                 ("Run", f"fit converged: {one['converged']} in {one['iterations']} iterations; "
                         f"{pair.epochs.size} epochs of range and range-rate.\n"),
                 (f"Sensitivity to the unspecified set-up (CRLB at day {day}, paper: about 1 m)",
                  write_table(out, "sensitivity", sensitivity(cfg)))]
-    write_markdown(out, "LiAISON scenario 1: GEO + EML1 halo, CRTBP baseline (Fujimoto et al. sec. 2.1)", sections)
+    write_markdown(out, "Study halo_geo_crtbp: GEO + EML1 halo in the CRTBP (Fujimoto et al. sec. 2.1)", sections)
     for r in rows:
         log(f"{r['spacecraft']}: {r['quantity']}: paper {r['paper']}, odpipe {r['odpipe']:.4g}")
     return {"table": table}

@@ -1,4 +1,4 @@
-"""Scenario 2 (seed 002, Turan et al.): range-only vs range-rate-only crosslinks in cislunar formations.
+"""Range-only vs range-rate-only crosslinks in cislunar formations (seed 002, Turan et al. 2022).
 
 Pairs EML1/EML2 halo, EML1 halo/lunar orbiter and EML2 halo/lunar orbiter in the
 CRTBP; halos picked from their families by the periods of Table 1, the lunar
@@ -20,16 +20,17 @@ from dataclasses import replace
 import numpy as np
 import pandas as pd
 
+from odpipe.constants import SECONDS_PER_DAY
 from odpipe.analysis.montecarlo import monte_carlo, rms_over_runs, rss
 from odpipe.analysis.observability import gramian, observability_measures, snr_ratio
 from odpipe.dynamics.crtbp import jacobi_constant
 
 from .crtbp_problem import RANGE, RANGE_RATE, units_from_mu
-from .orbits import halo_by_period, halo_start, keplerian_orbit
-from .pair import CrosslinkPair
-from .report import plot_convergence, write_markdown, write_table
+from .crtbp_orbits import halo_by_period, halo_start, keplerian_orbit
+from .crosslink_pair import CrosslinkPair
+from .study_report import plot_convergence, write_markdown, write_table
 
-DAY = 86400.0
+DAY = SECONDS_PER_DAY
 TYPES = {"range": (RANGE,), "range-rate": (RANGE_RATE,)}
 
 
@@ -253,5 +254,5 @@ def run(cfg: dict, out, log=print) -> dict:
                              "sc2 rate/range": level["range-rate"][1] / level["range"][1]})
     sections.append(("State-noise compensation (CRLB, eq. 3.31): the paper's tuned SNC narrows the gap",
                      write_table(out, "snc", pd.DataFrame(snc_rows))))
-    write_markdown(out, "LiAISON scenario 2: range-only vs range-rate-only (Turan et al.)", sections)
+    write_markdown(out, "Study formation_observability: range-only vs range-rate-only (Turan et al.)", sections)
     return {"table1": side, "montecarlo": mc_df, "sweep": pd.DataFrame(sweep_rows)}

@@ -6,16 +6,17 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from odpipe.liaison.config import load_config
+from odpipe.studies.scenarios import load_config
 from odpipe.dynamics.propagator import propagate
 from odpipe.estimation.fit import build_grid
 from odpipe.estimation.registry import ParameterRegistry
-from odpipe.liaison.doppler import NAMES, R_EARTH, _rows, force_models, link_clear
+from odpipe.studies.halo_geo_doppler import NAMES, R_EARTH, _rows, force_models, link_clear
 from odpipe.measurements import MeasurementSetup, compute
 from odpipe.od.problem import TrackingProblem
 from odpipe.time import utc_to_tdb
+from study_runs import as_recorded, run_study, whole_run
 
-CFG = load_config(Path(__file__).parents[1] / "runs" / "liaison_doppler.toml")
+CFG = load_config(Path(__file__).parents[1] / "runs" / "study_halo_geo_doppler.toml")
 
 
 def test_link_blocked_only_through_the_earth():
@@ -51,3 +52,37 @@ def test_simulated_doppler_equals_the_fit_reference():
     # well below the X-band noise (0.1 mm/s)
     assert np.max(np.abs(reference - simulated)) < 2e-5
     assert np.allclose(to_los, 0.5)
+
+
+# odpipe's Tables 4-5 for the shipped configuration (3-D RMS over the last half of the arc; seeded run):
+# (band, spacecraft, quantity) -> figure as recorded
+TABLES45 = {("S", "L1", "Pos"): "165", ("S", "GEO", "Pos"): "25.0", ("X", "L1", "Pos"): "82",
+            ("X", "GEO", "Pos"): "10.6"}
+
+
+def _tables45():
+    table = run_study("study_halo_geo_doppler")["table"]
+    return {(r["band"], r["spacecraft"], r["quantity"].split()[0]): r for _, r in table.iterrows()}
+
+
+@whole_run
+def test_whole_run_tables45_snapshot():
+    """odpipe's 3-D position RMS of Tables 4-5, to the digits docs/validation.md records."""
+    rows = _tables45()
+    for key, recorded in TABLES45.items():
+        assert rows[key]["odpipe 3D"] == as_recorded(recorded), key
+
+
+@whole_run
+def test_whole_run_tables45_disagree_with_the_paper_as_recorded():
+    """odpipe does NOT reproduce Tables 4-5: its positions are 1.8-7.5x better than the paper's (S band: L1 0.56x,
+    GEO 0.33x; X band 0.28x, 0.13x), and its X band is 2-2.4x better than its S band where the paper's two bands
+    are nearly equal (its accuracy is not set by the data noise). The paper's single EKF pass against odpipe's
+    iterated filter-smoother is the likelier cause; it is not measured yet. What does agree: the GEO satellite
+    is better determined than the halo in both bands, as in the paper."""
+    rows = _tables45()
+    for band in ("S", "X"):
+        for sc in ("L1", "GEO"):
+            assert rows[(band, sc, "Pos")]["odpipe/paper 3D"] < 0.6
+        assert rows[(band, "GEO", "Pos")]["odpipe 3D"] < rows[(band, "L1", "Pos")]["odpipe 3D"]
+    assert rows[("X", "L1", "Pos")]["odpipe 3D"] < 0.6 * rows[("S", "L1", "Pos")]["odpipe 3D"]

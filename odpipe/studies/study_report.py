@@ -1,4 +1,4 @@
-"""Scenario products: paper-vs-odpipe tables (CSV + Markdown) and convergence plots (PNG).
+"""Study products: paper-vs-odpipe tables (CSV + Markdown) and convergence plots (PNG).
 
 All files are written atomically into the run directory.
 """

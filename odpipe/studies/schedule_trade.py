@@ -1,6 +1,6 @@
-"""Scenario 4, trade study (Leonard's thesis secs. 8.1.2.3-8.1.2.4): the Fig. 8.4 mesh of
+"""The tracking-schedule trade study (Leonard 2015, secs. 8.1.2.3-8.1.2.4): the Fig. 8.4 mesh of
 (LiAISON gap, ground gap) schedules and the Fig. 8.9 scheduling offset, on the set-up of
-:mod:`.ground` (same truth, data, noise and filter).
+:mod:`.ground_and_crosslink` (same truth, data, noise and filter).
 
 * Mesh: every pair of ``mesh.gaps_h`` (h after each 3-h pass; ``inf`` = that data type unused),
   3-D position 3-sigma and error of the forward filter, RMS over days 6-9, per spacecraft.
@@ -17,8 +17,8 @@ import pandas as pd
 
 from parsers.atomic import save_figure
 
-from .ground import NAMES, fit_schedule, prepare
-from .report import plot_convergence, write_markdown, write_table
+from .ground_and_crosslink import NAMES, fit_schedule, prepare
+from .study_report import plot_convergence, write_markdown, write_table
 
 
 def _fit(cfg, sim, case) -> dict:
@@ -59,8 +59,10 @@ def plot_mesh(out: Path, df: pd.DataFrame, gaps) -> Path:
     return path
 
 
-def run(cfg: dict, out, log=print) -> dict:
-    sim = prepare(cfg, log)
+def run(cfg: dict, out, log=print, sim: dict | None = None) -> dict:
+    """The mesh and the offset study on ``sim`` (a :func:`prepare` of this set-up; made when None); writes
+    report.md, the tables and plots into ``out``."""
+    sim = sim or prepare(cfg, log)
     gaps = [float(g) for g in cfg["mesh"]["gaps_h"]]
     mesh = []
     for lg in gaps:
@@ -99,8 +101,8 @@ def run(cfg: dict, out, log=print) -> dict:
          "![offset](offset.png)\n\nOffset / simultaneous 3-sigma, by gap:\n\n"
          + write_table(out, "offset_ratio", ratio.reset_index())
          + "\n" + write_table(out, "offset", offset[cols + ["ground_offset_h", "converged"]])),
-        ("Set-up", "As `liaison_ground.toml` (see its report for the differences from the thesis); the "
+        ("Set-up", "As `study_ground_and_crosslink.toml` (see its report for the differences from the thesis); the "
                    "x-axis of the offset plot is the gap in hours.\n")]
-    write_markdown(out, "LiAISON scenario 4: tracking-schedule trade study (Leonard thesis secs. 8.1.2.3-8.1.2.4)",
+    write_markdown(out, "Study schedule_trade: tracking-schedule trade study (Leonard thesis secs. 8.1.2.3-8.1.2.4)",
                    sections)
     return {"mesh": mesh, "offset": offset, "ratio": ratio}

@@ -4,7 +4,7 @@ import numpy as np
 import pytest
 
 from odpipe.estimation.registry import ParameterRegistry
-from odpipe.liaison.crtbp_problem import CrosslinkProblem, crosslink_rows, units_from_mu
+from odpipe.studies.crtbp_problem import CrosslinkProblem, crosslink_rows, units_from_mu
 
 U = units_from_mu(384747.96e3, 398600.4415e9 / (1 - 0.01215), 0.01215)
 X1 = U.to_si(np.array([0.8326, 0.0, 0.1289, 0.0, 0.2425, 0.0]))

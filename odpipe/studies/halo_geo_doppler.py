@@ -1,5 +1,5 @@
-"""Scenario 1b (seed 000, Fujimoto et al. secs. 3-4): GEO + EML1 halo, two-way crosslink Doppler,
-high-fidelity dynamics.
+"""An L1 halo and a GEO satellite with two-way crosslink Doppler and high-fidelity dynamics (seed 000,
+Fujimoto et al. secs. 3-4).
 
 Truth: Earth-centred ICRF states of Table 1 at 2020-01-01 (UTC), point masses of the
 Sun, Moon and planets (DE440; the paper: DE405) and a 20x20 Earth field on the GEO
@@ -23,6 +23,7 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 
+from odpipe.constants import EGM96_RADIUS, SECONDS_PER_DAY
 from odpipe.dynamics.forces import ForceModel, PointMasses, SphericalHarmonics
 from odpipe.dynamics.propagator import propagate
 from odpipe.environment.gravity import read_gravity
@@ -33,10 +34,10 @@ from odpipe.od.problem import TrackingProblem
 from odpipe.time import utc_to_tdb
 from parsers.table import build
 
-from .report import plot_convergence, write_markdown, write_table
+from .study_report import plot_convergence, write_markdown, write_table
 
-DAY = 86400.0
-R_EARTH = 6378136.3
+DAY = SECONDS_PER_DAY
+R_EARTH = EGM96_RADIUS
 NAMES = ("L1", "GEO")
 DIFFERENCES = """\
 - Filter: odpipe's iterated square-root information filter-smoother, relinearized about the smoothed
@@ -150,7 +151,7 @@ def run(cfg: dict, out, log=print) -> dict:
                       f"{clear.size} epochs tracked (link clear of the Earth, GEO |v_x| >= "
                       f"{cfg['filter'].get('geo_cutoff_vx_mps', 0.0)} m/s), converged {r['converged']}"
                       for band, r in results.items())
-    write_markdown(out, "LiAISON scenario 1b: GEO + EML1 halo, two-way crosslink Doppler (Fujimoto et al. secs. 3-4)",
+    write_markdown(out, "Study halo_geo_doppler: GEO + EML1 halo, two-way crosslink Doppler (Fujimoto et al. secs. 3-4)",
                    [("Tables 4-5: accuracy RMS over the last half, paper vs odpipe",
                      write_table(out, "tables45", table) + "\n![convergence](convergence.png)\n"),
                     ("Fit", notes + "\n"), ("Differences from the paper's set-up", DIFFERENCES)])

@@ -4,7 +4,7 @@ import numpy as np
 import pytest
 
 from odpipe.dynamics.crtbp import jacobi_constant, propagate_crtbp
-from odpipe.liaison.orbits import correct_halo, halo_by_period, halo_start, keplerian_orbit
+from odpipe.studies.crtbp_orbits import correct_halo, halo_by_period, halo_start, keplerian_orbit
 
 MU = 0.01215
 

@@ -7,20 +7,21 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from odpipe.liaison.config import load_config
+from odpipe.studies.scenarios import load_config
 from odpipe.dynamics.forces import AtmosphericDrag, ForceModel, PointMasses, SolarRadiationPressure
 from odpipe.dynamics.propagator import propagate
 from odpipe.estimation.registry import ParameterRegistry
-from odpipe.liaison import dowr
+from odpipe.studies import dro_leo_dowr as dowr
 from odpipe.measurements import MeasurementSetup
 from odpipe.constants import C_LIGHT
 from odpipe.measurements.crosslink import ClockModel, one_way_pseudorange
 from odpipe.measurements.lighttime import solve_path
 from odpipe.measurements.nodes import SpacecraftNode
 from odpipe.time import utc_to_tdb
+from study_runs import as_recorded, run_study, whole_run
 
 ROOT = Path(__file__).resolve().parents[1]
-CFG = load_config(ROOT / "runs/liaison_dowr.toml")
+CFG = load_config(ROOT / "runs/study_dro_leo_dowr.toml")
 EPOCH = np.datetime64(CFG["epoch_utc"], "ns")
 T0 = float(utc_to_tdb(EPOCH))
 
@@ -110,7 +111,7 @@ def test_reduced_run_dowr_clock_and_mode_ordering(shared_data, tmp_path):
     """Three days, the true dynamics (Model-A, fields cut to degree 20 for speed), DOWR (Simu. 6) against
     one-way ranging (the Simu. 8 link plan): Table 13's ordering (one-way 7x worse on the clock and
     20-240x on the DRO position), the LEO converging first (Simu. 6: 2 days), the clock below 100 ns
-    (sec. 5.4.3). (Table 13's 40-day figures themselves need the full run: runs/liaison_dowr.toml.)"""
+    (sec. 5.4.3). (Table 13's 40-day figures themselves need the full run: runs/study_dro_leo_dowr.toml.)"""
     cfg = dict(CFG, arc_days=3.0, last_days=1.0, stage_days=[0.5], max_iter=4, final_iter=2,
                earth_gravity=str(shared_data / "gravity/tudat/ggm02c.txt"),
                moon_gravity=str(shared_data / "gravity/gmat/LP165P.cof"))
@@ -126,3 +127,49 @@ def test_reduced_run_dowr_clock_and_mode_ordering(shared_data, tmp_path):
     assert d["LEO"]["converge_days"] is not None and d["LEO"]["converge_days"] < 2.0
     assert d["LEO"]["pos"] < 0.2 * d["DRO"]["pos"]
     assert (tmp_path / "report.md").read_text().count("Simu.") >= 4
+
+
+# Table 13 as odpipe computes it for the shipped configurations (docs/validation.md, session 6; the runs are
+# seeded): simulation -> (DRO pos m, LEO pos m, clock ns), each to the digits recorded there
+TABLE13 = {"Simu. 1": ("12.2", "133", "10.3"), "Simu. 2": ("7.85", "13.6", "10.3"), "Simu. 3": ("7.26", "11.9", "10.3"),
+           "Simu. 4": ("59.0", "100", "10.3"), "Simu. 5": ("186", "5709", "10.5"), "Simu. 6": ("0.27", "0.40", "10.3"),
+           "Simu. 7": ("54.6", "68.0", "10.3"), "Simu. 8": ("67.2", "17.9", "54.0"), "Simu. 9": ("9.8", "16.6", "9.8")}
+
+
+def _table13():
+    results = {}
+    for config in ("study_dro_leo_dowr", "study_dro_leo_dowr_integrators"):
+        results.update(run_study(config)["results"])
+    return results
+
+
+@whole_run
+def test_whole_run_table13_snapshot():
+    """odpipe's Table 13 (DRO and LEO 3-D position RMS over the last 8 days, DRO clock accuracy) to the digits
+    docs/validation.md records: a several-fold change cannot pass."""
+    results = _table13()
+    for name, (dro, leo, clock) in TABLE13.items():
+        acc = results[name]
+        for got, want in ((acc["DRO"]["pos"], dro), (acc["LEO"]["pos"], leo), (acc["clock_ns"], clock)):
+            assert got == as_recorded(want), name
+
+
+@whole_run
+def test_whole_run_table13_against_the_paper():
+    """Simulations 2, 3, 6 and 8 (DOWR with Model-B and the true model, the 30-s integrator, one-way ranging):
+    every position and clock figure within a factor 2 of the paper's (odpipe 0.52-1.57x). Tolerance: the paper
+    leaves the LEO time error's correlation time, the clock offset, the delay, the sampling and the initial
+    errors open, and runs one EKF pass where odpipe iterates a filter-smoother. The others do not agree and
+    are recorded by the snapshot: Simu. 4 and 5 (coarse fixed steps) LEO 4-8x worse, Simu. 9 DRO 7.5x better
+    (the pass alternation is not given), Simu. 1 LEO 2.6x worse, Simu. 7 LEO 3x better."""
+    results = _table13()
+    sims = {s["name"]: s for s in load_config(ROOT / "runs/study_dro_leo_dowr.toml")["simulation"]
+            + load_config(ROOT / "runs/study_dro_leo_dowr_integrators.toml")["simulation"]}
+    for name in ("Simu. 2", "Simu. 3", "Simu. 6", "Simu. 8"):
+        acc, paper = results[name], sims[name]["paper"]
+        for got, want in ((acc["DRO"]["pos"], paper["DRO"]["pos_m"]), (acc["LEO"]["pos"], paper["LEO"]["pos_m"]),
+                          (acc["clock_ns"], paper["clock_ns"])):
+            assert 0.5 < got / want < 2.0, name
+    # the paper's orderings: DOWR beats one-way ranging on the DRO, the true model beats Model-B
+    assert results["Simu. 8"]["DRO"]["pos"] > 5 * results["Simu. 2"]["DRO"]["pos"]
+    assert results["Simu. 2"]["DRO"]["pos"] > 10 * results["Simu. 6"]["DRO"]["pos"]

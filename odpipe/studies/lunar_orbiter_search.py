@@ -1,20 +1,19 @@
-"""Seed 002 (Turan et al.): which lunar orbiters reproduce Table 1's lunar formations?
+"""Which lunar orbiters reproduce the lunar formations of Table 1 (seed 002, Turan et al.)?
 
 The paper gives the orbiter's period only (0.93 d). This draws random orbiters of that
 period (eccentricity from a grid, inclination, node, argument of periselene and start
 phase uniform) and evaluates the 8 lunar columns of Table 1 (EML1/Lunar, EML2/Lunar) with
-the halos of ``runs/liaison_turan.toml``; for each orbiter, the geometric-mean and the worst
+the halos of ``runs/study_formation_observability.toml``; for each orbiter, the geometric-mean and the worst
 factor between odpipe's Gramian measures (cond, 1/min eig; range, range-rate) and the paper's.
 
-Writes OUT/lunar_search.csv (default runs/out/turan_lunar_search) and prints the summary by
+Writes OUT/lunar_search.csv (default runs/out/lunar_orbiter_search) and prints the summary by
 eccentricity and by start phase and the best orbiters.
-Run: ``.venv/bin/python runs/turan_lunar_search.py [OUT] [--candidates 300] [--seed 1]``.
+Run: ``.venv/bin/python -m odpipe.studies.lunar_orbiter_search [OUT] [--candidates 300] [--seed 1]``.
 """
 
 from __future__ import annotations
 
 import argparse
-import tomllib
 from concurrent.futures import ProcessPoolExecutor
 from dataclasses import replace
 from functools import lru_cache
@@ -23,21 +22,22 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 
-from odpipe.liaison import turan
-from odpipe.liaison.orbits import keplerian_orbit
+from odpipe.studies import formation_observability as study
+from odpipe.studies.crtbp_orbits import keplerian_orbit
+from odpipe.studies.scenarios import load_config
 from parsers.atomic import write_csv
 
-HERE = Path(__file__).resolve().parent
-CFG = tomllib.loads((HERE / "liaison_turan.toml").read_text())
+RUNS = Path(__file__).resolve().parents[2] / "runs"
+CFG = load_config(RUNS / "study_formation_observability.toml")
 ECCENTRICITIES = (0.0, 0.2, 0.4, 0.6, 0.75)
 
 
 @lru_cache(maxsize=1)
 def setup():
     """Units, orbits and Table 1 formations of the scenario (once per process)."""
-    U = turan.units(CFG)
-    orb = turan.orbits(CFG, U)
-    return U, orb, turan.formations(CFG, U, orb)
+    U = study.units(CFG)
+    orb = study.orbits(CFG, U)
+    return U, orb, study.formations(CFG, U, orb)
 
 
 def evaluate(orbiter: dict) -> dict:
@@ -45,14 +45,14 @@ def evaluate(orbiter: dict) -> dict:
     U, orb, cols = setup()
     angles = np.radians([orbiter[k] for k in ("inc_deg", "raan_deg", "argp_deg", "true_anomaly_deg")])
     x = U.to_si(keplerian_orbit(orb["lunar"][1], orbiter["ecc"], angles[0], U.mu, *angles[1:]))
-    L = np.abs([turan.log_ratios(turan.observability_row(replace(pair, x2=x)), CFG["paper"]["table1"], j)
+    L = np.abs([study.log_ratios(study.observability_row(replace(pair, x2=x)), CFG["paper"]["table1"], j)
                 for j, (label, pair) in enumerate(cols) if "Lunar" in label])
     return {**orbiter, "mean factor": 10 ** L.mean(), "worst factor": 10 ** L.max()}
 
 
 def main():
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    ap.add_argument("out", nargs="?", default=HERE / "out" / "turan_lunar_search", type=Path)
+    ap.add_argument("out", nargs="?", default=RUNS / "out" / "lunar_orbiter_search", type=Path)
     ap.add_argument("--candidates", type=int, default=300)
     ap.add_argument("--seed", type=int, default=1)
     args = ap.parse_args()

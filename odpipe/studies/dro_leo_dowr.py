@@ -1,4 +1,4 @@
-"""Scenario 3 (seed 003, Li et al.): DRO-LEO autonomous navigation by dual one-way ranging (DOWR).
+"""DRO-LEO autonomous navigation by dual one-way ranging, DOWR (seed 003, Li et al. 2023, Table 13).
 
 Truth (Table 4): Earth-centred ICRF, from 2023-01-01 for 40 days; the DRO state of Table 3 and
 a circular sun-synchronous LEO (a = 6878.137 km, i = 97.4065 deg, RAAN = 10.3886 deg, u = 0);
@@ -38,6 +38,7 @@ import numpy as np
 import pandas as pd
 from scipy.signal import lfilter
 
+from odpipe.constants import SECONDS_PER_DAY
 from odpipe.analysis.montecarlo import parallel_map
 from odpipe.dynamics.forces import (AtmosphericDrag, ForceModel, PointMasses, SolarRadiationPressure,
                                     SphericalHarmonics)
@@ -52,10 +53,10 @@ from odpipe.od.problem import TrackingProblem
 from odpipe.time import utc_to_tdb
 from parsers.table import build
 
-from .doppler import link_clear
-from .report import plot_convergence, write_markdown, write_table
+from .halo_geo_doppler import link_clear
+from .study_report import plot_convergence, write_markdown, write_table
 
-DAY = 86400.0
+DAY = SECONDS_PER_DAY
 NAMES = ("DRO", "LEO")
 ONE_WAY = "sst_1way"     # pseudorange received by spacecraft_2 (LEO) from spacecraft (DRO)
 # each row observable as a combination of compute()'s: R_LEO = (sum) - (difference)
@@ -442,7 +443,7 @@ def run(cfg: dict, out, log=print) -> dict:
                          f"delay {c['delay_m']} m)" for name, r in results.items())
              + "\n- one-way ranging alone cannot tell the delay from the DRO clock offset (both enter every "
                "row alike): their split rests on the a priori")
-    write_markdown(out, "LiAISON scenario 3: DRO-LEO dual one-way ranging (Li et al., Table 13)",
+    write_markdown(out, "Study dro_leo_dowr: DRO-LEO dual one-way ranging (Li et al., Table 13)",
                    [("Table 13: 3-D RMS over the last 8 days, paper vs odpipe",
                      write_table(out, "table13", table) + "\n![position](position.png)\n\n![clock](clock.png)\n"),
                     ("Set-up", notes + "\n"), ("Differences from the paper's set-up", DIFFERENCES)])

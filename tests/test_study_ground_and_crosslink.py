@@ -1,0 +1,237 @@
+"""Study ground_and_crosslink (Leonard 2015, sec. 8.1) and its trade study schedule_trade (secs.
+8.1.2.3-8.1.2.4): an EML1 halo orbiter and a GEO satellite tracked from the ground alone, by crosslinks
+alone and by both.
+
+The thesis' figures (runs/study_ground_and_crosslink.toml [paper], read from the text of sec. 8.1.2.3) are
+checked against odpipe's with the tolerance the text allows, or recorded as disagreements where odpipe
+does not agree; odpipe's own figures are snapshots (relative 1e-3: the run is seeded). The default suite
+fits three schedules (ground only, crosslinks only, both) and the 22-h offset pair on one shared set-up;
+the other schedules need the whole run (``ODPIPE_STUDY_RUNS=1``, tests/study_runs.py).
+
+Tolerance for agreement: a factor 2. The thesis quotes rounded figures ("about 70 m", "on the order of
+10 m") and does not give the correlation time of its empirical accelerations; odpipe takes 1 day, and
+with 3 h the ground-only halo figure moves to 0.44x of the thesis', outside the bound: the agreement
+depends on that choice."""
+
+from pathlib import Path
+
+import numpy as np
+import pytest
+from scipy.stats import chi2
+
+from odpipe.dynamics.propagator import propagate
+from odpipe.environment.ephemeris import Ephemeris
+from odpipe.environment.stations import itrs_to_geodetic
+from odpipe.frames.earth import gcrs_to_itrs_state
+from odpipe.studies import ground_and_crosslink as ground
+from odpipe.studies import schedule_trade
+from odpipe.studies.scenarios import load_config
+from odpipe.time import utc_to_tdb
+from study_runs import as_recorded, run_study, whole_run
+
+CFG = load_config(Path(__file__).parents[1] / "runs" / "study_ground_and_crosslink.toml")
+CASES = ("ground", "ground_liaison", "liaison")   # (inf, 0), (0, 0) and (0, inf) of the thesis' Fig. 8.4/8.5
+# odpipe's figures (m), recorded 2026-11-25: 3-D 3-sigma RMS over days 6-9 and at the end of the arc
+RECORDED = {
+    ("ground", "L1"): {"rms_sig3": 35.7961, "final_sig3": 29.6852},
+    ("ground", "GEO"): {"rms_sig3": 350.567, "final_sig3": 455.538},
+    ("ground_liaison", "L1"): {"rms_sig3": 20.5693, "final_sig3": 17.9532},
+    ("ground_liaison", "GEO"): {"rms_sig3": 3.68463, "final_sig3": 2.89997},
+    ("liaison", "L1"): {"rms_sig3": 50.2427, "final_sig3": 27.8771},
+    ("liaison", "GEO"): {"rms_sig3": 8.02448, "final_sig3": 4.15985},
+}
+
+
+def test_schedule_of_passes_and_gaps():
+    """(28,49)-type schedules: 3-h passes every pass + gap hours from epoch; inf = never, 0 = always."""
+    t = np.arange(0.0, 9 * 86400.0, 100.0)
+    on = ground.scheduled(t, 49.0, 3.0)
+    assert on.sum() == 5 * 108                 # passes at 0, 52, 104, 156 and 208 h, 108 samples each
+    assert on[t == 52 * 3600.0].all() and not on[t == 55 * 3600.0].any()
+    assert not ground.scheduled(t, np.inf, 3.0).any() and ground.scheduled(t, 0.0, 3.0).all()
+
+
+def test_ground_passes_offset_by_half_the_gap():
+    """Sec. 8.1.2.4: LiAISON passes at 0, 25, 50 h; ground passes start halfway through each gap (14 h)."""
+    import pandas as pd
+
+    t = np.arange(0.0, 3 * 86400.0, 600.0)
+    rows = pd.DataFrame({"time": np.concatenate([t, t]), "link": ["sst"] * t.size + ["dsn"] * t.size})
+    sel = ground.case_rows(CFG, rows, {"liaison_gap_h": 22.0, "ground_gap_h": 22.0, "ground_offset_h": 11.0}, 0.0)
+    sst, dsn = (sel.loc[sel.link == k, "time"].to_numpy() / 3600.0 for k in ("sst", "dsn"))
+    assert sst.min() == 0.0 and sst.max() < 53.0 and set(np.floor(sst / 25.0)) == {0, 1, 2}
+    assert dsn.min() == 11.0 and np.all((dsn - 11.0) % 25.0 < 3.0)
+    assert not np.any(np.isin(np.round(sst, 6), np.round(dsn, 6)))             # never simultaneous
+
+
+@pytest.mark.realdata
+def test_geo_satellite_stays_over_the_thesis_longitude():
+    """The GEO start state is geostationary: radius 42,164 km and the sub-satellite point of
+    sec. 8.1.1.2 held within 0.1 deg over a day of the truth dynamics."""
+    eph = Ephemeris.open("de440")
+    t0 = float(utc_to_tdb(np.datetime64(CFG["epoch_utc"], "ns")))
+    x0 = ground.geo_state(CFG, t0, eph.gm("earth"))
+    assert np.linalg.norm(x0[:3]) == pytest.approx(42164.17e3, abs=1e3)
+    traj = propagate(x0, t0, t0 + 86400.0, ground.force_models(CFG, eph, "truth")["GEO"], with_stm=False)
+    t = t0 + np.linspace(0.0, 86400.0, 25)
+    r, _ = gcrs_to_itrs_state(t, traj.state(t)[:, :3], traj.state(t)[:, 3:])
+    lat, lon, _ = itrs_to_geodetic(r)
+    assert np.max(np.abs(np.degrees(lon) - CFG["geo"]["lon_deg"])) < 0.1
+    assert np.max(np.abs(np.degrees(lat))) < 0.3
+
+
+@pytest.fixture(scope="module")
+def scenario(tmp_path_factory):
+    """The study on CASES (no sensitivity refits), its set-up kept for the trade study's test."""
+    cfg = dict(CFG, cases={k: CFG["cases"][k] for k in CASES}, sensitivity=dict(CFG["sensitivity"], cases=[]))
+    return ground.run(cfg, tmp_path_factory.mktemp("study_ground"), log=lambda m: None)
+
+
+def _row(scenario, case, sc):
+    df = scenario["table"]
+    return df[(df["case"] == case) & (df["spacecraft"] == sc)].iloc[0]
+
+
+def _figures(row) -> dict:
+    return {"rms_sig3": row["odpipe 3s RMS d6-9"], "final_sig3": row["odpipe final 3s"],
+            "below100_d": row["odpipe day 3s<100 m"]}
+
+
+@pytest.mark.realdata
+def test_snapshot_of_three_schedules(scenario):
+    """odpipe's 3-sigma figures of ground only, both and crosslinks only, relative 1e-3."""
+    for (case, sc), recorded in RECORDED.items():
+        got = _figures(_row(scenario, case, sc))
+        for key, value in recorded.items():
+            assert got[key] == pytest.approx(value, rel=1e-3), (case, sc, key)
+
+
+@pytest.mark.realdata
+def test_ground_and_both_against_the_thesis(scenario):
+    """Agreement within a factor 2 (module docstring): ground only, halo over days 6-9 (thesis about 70 m, odpipe
+    36 m: 0.51x); ground + crosslinks, final halo and GEO (thesis "on the order of" 10 m and 3 m, odpipe 18 m and
+    2.9 m). And the thesis' ordering: both data types beat ground alone for each spacecraft."""
+    paper = CFG["paper"]
+    g_l1, g_geo = _row(scenario, "ground", "L1"), _row(scenario, "ground", "GEO")
+    b_l1, b_geo = _row(scenario, "ground_liaison", "L1"), _row(scenario, "ground_liaison", "GEO")
+    assert 0.5 < g_l1["odpipe 3s RMS d6-9"] / paper["ground"]["L1_rms_sig3"] < 2.0
+    assert 0.5 < b_l1["odpipe final 3s"] / paper["ground_liaison"]["L1_final_sig3"] < 2.0
+    assert 0.5 < b_geo["odpipe final 3s"] / paper["ground_liaison"]["GEO_final_sig3"] < 2.0
+    assert b_l1["odpipe 3s RMS d6-9"] < 0.7 * g_l1["odpipe 3s RMS d6-9"]
+    assert b_geo["odpipe 3s RMS d6-9"] < 0.05 * g_geo["odpipe 3s RMS d6-9"]
+    assert b_geo["odpipe error RMS d6-9"] < 0.1 * g_geo["odpipe error RMS d6-9"]
+
+
+@pytest.mark.realdata
+def test_disagreements_with_the_thesis_as_they_are(scenario):
+    """Where odpipe does NOT agree with the thesis, recorded as it is (the snapshot test holds the values):
+
+    - GEO from Sky Valley alone: the thesis says its a priori uncertainty is not reduced (the colour of Fig. 8.4
+      saturates above 150 m). odpipe shrinks the a priori 3-sigma (3-D, 5.2 km) about 15x, to 351 m over days
+      6-9: still above 150 m, so the figure's colour agrees, the statement does not. The cause is not found.
+    - Crosslinks only: thesis about 160 m (halo) and 24 m (GEO); odpipe about 3x tighter (50 m and 8 m)."""
+    paper, apriori_3d = CFG["paper"], 3 * np.sqrt(3) * CFG["filter"]["apriori_pos_m"]
+    geo = _row(scenario, "ground", "GEO")["odpipe 3s RMS d6-9"]
+    assert geo > 150.0 and apriori_3d / geo == pytest.approx(14.8, rel=1e-2)
+    for sc in ground.NAMES:
+        ratio = _row(scenario, "liaison", sc)["odpipe 3s RMS d6-9"] / paper["liaison"][f"{sc}_rms_sig3"]
+        assert ratio == pytest.approx(RECORDED[("liaison", sc)]["rms_sig3"] / paper["liaison"][f"{sc}_rms_sig3"],
+                                      rel=1e-3)
+        assert ratio < 0.5
+
+
+@pytest.mark.realdata
+@pytest.mark.parametrize("case", CASES)
+def test_truth_within_the_reported_covariance(scenario, case):
+    """Filtered errors over days 6-9 and the smoothed epoch states and biases agree with their covariance."""
+    res = scenario["results"][case]
+    sol, reg, m = res["solution"], res["registry"], res["metrics"]
+    for sc in ground.NAMES:
+        assert m[sc]["nees"] < 3.0                       # e'P^-1e/3 averaged: errors < 1.7 sigma RMS
+        assert m[sc]["err"][-1] < m[sc]["sig3"][-1]
+        i = reg.slice("state", sc)
+        e = sol.smoothed_x[0, i] - scenario["x0"][sc]
+        assert e @ np.linalg.solve(sol.smoothed_P[0, i, i], e) < chi2.ppf(0.999, 6)
+    observed = ground.observed_biases(CFG, res["rows"])
+    assert len(observed) == {"ground_liaison": 5, "ground": 4, "liaison": 1}[case]   # 3 DSN, Sky Valley, crosslink
+    for name in observed:
+        k = reg.index(name)
+        assert abs(sol.smoothed_x[0, k] - res["rows"].attrs["bias"][name]) < 3.0 * np.sqrt(sol.smoothed_P[0, k, k])
+
+
+@pytest.mark.realdata
+def test_schedule_trade_corners_and_offset(scenario, tmp_path):
+    """Fig. 8.4 corners and Fig. 8.9 at a 22-h gap, on the same set-up (its fits shared): both data types beat
+    either alone for both spacecraft; offsetting the ground passes by half the gap changes the 3-sigma by
+    < 25 % (thesis: "neither satellite's uncertainty or accuracy is impacted significantly")."""
+    cfg = load_config(Path(__file__).parents[1] / "runs" / "study_schedule_trade.toml")
+    setup_keys = set(CFG) - {"scenario", "cases", "paper", "report", "sensitivity"}
+    assert {k: cfg[k] for k in setup_keys} == {k: CFG[k] for k in setup_keys}     # the set-up is the same
+    cfg = dict(cfg, mesh={"gaps_h": [0.0, np.inf]}, offset={"gaps_h": [22.0]})
+    res = schedule_trade.run(cfg, tmp_path, log=lambda m: None, sim=scenario["sim"])
+    mesh = res["mesh"].set_index(["liaison_gap_h", "ground_gap_h"])
+    for sc in ground.NAMES:
+        both = mesh.loc[(0.0, 0.0), f"{sc} rms_sig3"]
+        assert both < mesh.loc[(0.0, np.inf), f"{sc} rms_sig3"] and both < mesh.loc[(np.inf, 0.0), f"{sc} rms_sig3"]
+        assert both == pytest.approx(RECORDED[("ground_liaison", sc)]["rms_sig3"], rel=1e-3)
+    assert np.all(np.abs(res["ratio"].to_numpy() - 1.0) < 0.25)
+    for name in ("report.md", "mesh.png", "offset.png", "mesh.csv", "offset_ratio.csv"):
+        assert (tmp_path / name).stat().st_size > 0
+
+
+# odpipe's figures of the whole runs as docs/validation.md records them (seeded): case -> (L1, GEO) 3-D 3-sigma
+# RMS over days 6-9 (m), or the day after which it stays below 100 m
+WHOLE_RMS = {"liaison_2_per_day_ground_69": ("50.0", "9.3"), "sparse": ("76", "21")}
+WHOLE_BELOW100 = {"ground_liaison_72": ("3.6", "3.1")}
+
+
+@whole_run
+@pytest.mark.realdata
+def test_whole_run_other_schedules_against_the_thesis():
+    """The schedules the default suite does not fit. Agreement within a factor 2 (module docstring): LiAISON twice a
+    day + ground every 3 days (thesis about 50/10 m), the sparse (28, 49) region (about 110/35 m), (72, 0) below
+    100 m from day 3/3; snapshots to the recorded digits. The Table 8.3 accelerations tripled bring crosslinks
+    only to 125/18.6 m (thesis 160/24): the disagreement above is the noise model's choice."""
+    table = run_study("study_ground_and_crosslink")["table"]
+    row = {(r["case"], r["spacecraft"]): r for _, r in table.iterrows()}
+    paper = CFG["paper"]
+    for case, recorded in WHOLE_RMS.items():
+        for sc, text in zip(ground.NAMES, recorded):
+            got = row[(case, sc)]["odpipe 3s RMS d6-9"]
+            assert got == as_recorded(text) and 0.5 < got / paper[case][f"{sc}_rms_sig3"] < 2.0, (case, sc)
+    for case, recorded in WHOLE_BELOW100.items():
+        for sc, text in zip(ground.NAMES, recorded):
+            got = row[(case, sc)]["odpipe day 3s<100 m"]
+            assert got == as_recorded(text) and 0.5 < got / paper[case][f"{sc}_below100_d"] < 2.0, (case, sc)
+    for sc, text in zip(ground.NAMES, ("125", "18.6")):
+        assert row[("liaison (acc x3)", sc)]["odpipe 3s RMS d6-9"] == as_recorded(text)
+
+
+@whole_run
+@pytest.mark.realdata
+def test_whole_run_schedule_trade():
+    """The Fig. 8.4 mesh and the Fig. 8.9 offset study, recorded figures: GEO needs the crosslinks (351-714 m from
+    ground alone, 3.7-73 m with crosslink gaps up to 28 h, 134 and 330 m with crosslinks alone every 52 or
+    75 h); crosslinks once a day alone keep the halo at 148 m; offsetting the ground
+    passes changes the 3-sigma by 0.88-1.27x at gaps of 6-60 h (thesis: not significantly), but 0.29x for the
+    halo at 72 h, where the offset puts a ground pass inside the day 6-9 window; the diagonal's local peaks (the
+    thesis' resonances) at 22 h for the halo (60 m against 45 m at 18 h and 53 m at 26 h) and 44 h for GEO
+    (35 m against 19 and 28 m)."""
+    res = run_study("study_schedule_trade")
+    mesh = res["mesh"].set_index(["liaison_gap_h", "ground_gap_h"])
+    ground_only = mesh.xs(np.inf, level="liaison_gap_h")["GEO rms_sig3"]
+    daily = mesh.loc[[k for k in mesh.index if k[0] <= 28.0], "GEO rms_sig3"]     # crosslink gaps up to 28 h
+    assert (ground_only.min(), ground_only.max()) == (as_recorded("351"), as_recorded("714"))
+    assert (daily.min(), daily.max()) == (as_recorded("3.7"), as_recorded("72.9"))
+    assert [mesh.loc[(g, np.inf), "GEO rms_sig3"] for g in (49.0, 72.0)] == [as_recorded("134"), as_recorded("330")]
+    assert mesh.loc[(22.0, np.inf), "L1 rms_sig3"] == as_recorded("148")
+    ratio = res["ratio"]
+    mid = ratio.loc[(ratio.index >= 6) & (ratio.index <= 60)].to_numpy()
+    assert (mid.min(), mid.max()) == (as_recorded("0.88"), as_recorded("1.27"))
+    assert ratio.loc[72.0, "L1 rms_sig3"] == as_recorded("0.29")
+    diagonal = res["offset"][res["offset"].ground_offset_h == 0].set_index("liaison_gap_h")
+    for sc, peak, sides in (("L1", 22.0, (18.0, 26.0)), ("GEO", 44.0, (36.0, 48.0))):
+        values = diagonal[f"{sc} rms_sig3"]
+        assert values[peak] > max(values[s] for s in sides)
+    assert [diagonal["L1 rms_sig3"][g] for g in (18.0, 22.0, 26.0)] == [as_recorded(t) for t in ("45", "60", "53")]
+    assert [diagonal["GEO rms_sig3"][g] for g in (36.0, 44.0, 48.0)] == [as_recorded(t) for t in ("19", "35", "28")]
