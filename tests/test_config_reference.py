@@ -9,7 +9,7 @@ import pytest
 
 from odpipe.cli import main
 from odpipe.commands.reference import document
-from odpipe.pipeline.config import RunConfig
+from odpipe.pipeline.config import RunConfig, reference
 from odpipe.operations.reference import field_comments, sections
 from odpipe.simulate.case import CaseFile
 
