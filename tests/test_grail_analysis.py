@@ -158,3 +158,15 @@ def test_per_pass_doppler_biases_are_registered():
                                         "bias.doppler_2way.DSS-24.pass4"]
     assert all(p.sigma == 1e-3 and p.info["observable"] == "doppler_2way" for p in biases)
     assert biases[1].info == {"observable": "doppler_2way", "station": "DSS-34", "spacecraft": "181", "pass_id": 5}
+
+
+def test_segments_of_stations_without_ramps_are_none():
+    """A station the ramp table does not hold (one-way, a non-DSN network: the demo's USN and Berkeley) gets
+    no segment; a DSS row inside a ramp gets that ramp's index."""
+    from odpipe.analysis.station_diagnostics import _segments
+
+    t = np.datetime64("2012-04-10T12:00:00", "ns")
+    trk = pd.DataFrame({"epoch": [t, t], "rtlt_s": [2.5, 2.5], "station_tx": ["DSS-24", "USN"]})
+    ramps = pd.DataFrame({"station": ["DSS-24"], "start": [t - np.timedelta64(600, "s")],
+                          "end": [t + np.timedelta64(600, "s")]}, index=[7])
+    assert list(_segments(trk, ramps)) == [7, -1]

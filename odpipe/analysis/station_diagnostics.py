@@ -62,6 +62,8 @@ def _segments(trk: pd.DataFrame, ramps: pd.DataFrame | None) -> np.ndarray:
     tx = trk["station_tx"].astype(str).to_numpy()
     for st in np.unique(tx):
         r = ramps[ramps["station"] == st].sort_values("start")
+        if not len(r):  # a station without ramps (one-way, a non-DSN network): no segments
+            continue
         on = tx == st
         k = np.searchsorted(r["start"].to_numpy("datetime64[ns]"), sent[on], side="right") - 1
         inside = (k >= 0) & (sent[on] < r["end"].to_numpy("datetime64[ns]")[np.clip(k, 0, None)])
