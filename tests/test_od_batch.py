@@ -2,7 +2,7 @@
 
 One filter-smoother pass about the a priori reference (1 km / 1 cm/s off, with a
 maneuver, SRP scale and per-pass range biases) against
-:func:`odpipe.estimation.batch.batch_least_squares` (normal equations, Cholesky)
+:func:`odpipe.estimation.least_squares.batch_least_squares` (normal equations, Cholesky)
 on the same rows, whose epoch partials are chained here from the problem's own
 ``predict``/``transition`` over the segments.
 """
@@ -11,7 +11,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from odpipe.estimation.batch import batch_least_squares
+from odpipe.estimation.least_squares import batch_least_squares
 from odpipe.od import ArcSetup, ManeuverPlan, fit_arc
 from test_od_simulate import arc_state, force_model, measurement_setup, scenario
 

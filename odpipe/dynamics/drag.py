@@ -30,7 +30,7 @@ import numpy as np
 from numba import njit
 
 from odpipe.constants import EARTH_ROTATION_RATE as OMEGA_EARTH, WGS84_A as R_EQUATOR, WGS84_F as FLATTENING
-from odpipe.dynamics.registry import Force, kernel
+from odpipe.dynamics.force_registry import Force, kernel
 
 BULGE_LAG = np.radians(30.0)
 

@@ -13,7 +13,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from odpipe.dynamics.registry import Force, kernel
+from odpipe.dynamics.force_registry import Force, kernel
 from odpipe.dynamics.rtn import rtn_acceleration, rtn_axes
 
 

@@ -20,7 +20,7 @@ A :class:`ForceModel` is a centre (NAIF name: 'earth', 'moon', 'sun', 'emb',
 :data:`FORCES` registers the forces: the compiled model holds one data namedtuple
 per entry, in this order, which is also the order in which the kernel adds them.
 To add a force: a module with its component, data, compile step and kernel
-(see :mod:`odpipe.dynamics.registry`), and one entry here.
+(see :mod:`odpipe.dynamics.force_registry`), and one entry here.
 
 Estimable dynamic parameters (names used by ``Trajectory.param_names``), in canonical
 order: ``srp_scale``, ``rho_s[k]``/``rho_d[k]`` (surface k), ``cd`` (drag),
@@ -41,7 +41,7 @@ from odpipe.dynamics.empirical import EMPIRICAL, EmpiricalRTN
 from odpipe.dynamics.gravity_fields import HARMONICS, ROTATION_GRID, SphericalHarmonics
 from odpipe.dynamics.pointmass import CENTRAL, THIRD_BODIES, PointMasses
 from odpipe.dynamics.polynomial import POLYNOMIAL, InertialPolynomialAcceleration
-from odpipe.dynamics.registry import CompileContext
+from odpipe.dynamics.force_registry import CompileContext
 from odpipe.dynamics.relativity import RELATIVITY, Relativity
 from odpipe.dynamics.srp import BODY_RADIUS, SRP, Cylinder, Plate, SolarRadiationPressure
 from odpipe.dynamics.thrust import BURNS, FiniteBurn, ImpulsiveManeuver, burn_rows

@@ -16,7 +16,7 @@ from typing import Callable
 import numpy as np
 
 from odpipe.dynamics.harmonics import ROWS, field_table, sh_acceleration, workspace
-from odpipe.dynamics.registry import Force, kernel
+from odpipe.dynamics.force_registry import Force, kernel
 from odpipe.environment.gravity import GravityField
 from odpipe.numerics.chebyshev import evaluate, fit_channel, stack_channels
 

@@ -17,7 +17,7 @@ from typing import Sequence
 import numpy as np
 from numba import njit
 
-from odpipe.dynamics.registry import Force, kernel
+from odpipe.dynamics.force_registry import Force, kernel
 
 BARYCENTRES = ("ssb", "emb")
 

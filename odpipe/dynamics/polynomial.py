@@ -17,7 +17,7 @@ from typing import Sequence
 
 import numpy as np
 
-from odpipe.dynamics.registry import Force, kernel
+from odpipe.dynamics.force_registry import Force, kernel
 
 PARAMETERS = ("x0", "y0", "z0", "x1", "y1", "z1")
 

@@ -15,7 +15,7 @@ from numba import njit
 
 from odpipe.constants import C_LIGHT
 from odpipe.dynamics.pointmass import central_gm
-from odpipe.dynamics.registry import Force, kernel
+from odpipe.dynamics.force_registry import Force, kernel
 
 
 @dataclass

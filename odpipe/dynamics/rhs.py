@@ -5,7 +5,7 @@ dr/dt = v, dv/dt = a(t, r, v; p), dPhi/dt = A Phi, dS/dt = A S + [0; da/dp],
 A = [[0, I], [da/dr, da/dv]]. Without the STM, y is the 6-vector only.
 ``model`` is the :data:`~odpipe.dynamics.forces.CompiledModel` made by
 :func:`odpipe.dynamics.forces.compile_model`; the acceleration is the sum of every
-registered force's ``contribute`` (:mod:`odpipe.dynamics.registry`).
+registered force's ``contribute`` (:mod:`odpipe.dynamics.force_registry`).
 """
 
 from __future__ import annotations
@@ -16,7 +16,7 @@ from numba.extending import overload
 
 from odpipe.dynamics.dop853 import derivative
 from odpipe.dynamics.forces import CompiledModel
-from odpipe.dynamics.registry import Environment, contribute
+from odpipe.dynamics.force_registry import Environment, contribute
 from odpipe.dynamics.thrust import spacecraft_mass
 from odpipe.environment.ephemeris import interp_positions
 

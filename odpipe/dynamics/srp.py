@@ -28,7 +28,7 @@ import numpy as np
 from numba import njit
 
 from odpipe.constants import AU, EGM96_RADIUS, MOON_RADIUS
-from odpipe.dynamics.registry import Force, kernel
+from odpipe.dynamics.force_registry import Force, kernel
 
 P_SUN_1AU = 4.56e-6  # N/m^2 at 1 AU (Montenbruck & Gill 2000)
 R_SUN = 6.96e8  # m, photospheric radius used for the shadow cones

@@ -10,7 +10,7 @@ iterated filter-smoother fit, maneuver products.
 builds one from odpipe.dynamics and odpipe.measurements.
 """
 
-from .batch import BatchSolution, batch_least_squares
+from .least_squares import BatchSolution, batch_least_squares
 from .fit import EDIT_INNOVATION, OUTSIDE_ARC, FitOptions, Observations, Problem, fit
 from .maneuvers import ManeuverFinding, detect_maneuvers, maneuver_table
 from .registry import GaussMarkov, Parameter, ParameterRegistry

@@ -3,7 +3,7 @@ fit when there is no process noise (smoothed epoch = batch epoch estimate)."""
 
 import numpy as np
 
-from odpipe.estimation.batch import batch_least_squares
+from odpipe.estimation.least_squares import batch_least_squares
 from odpipe.estimation.fit import FitOptions, fit
 from estimation_cases import twobody_case
 
