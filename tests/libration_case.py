@@ -53,7 +53,7 @@ def libration_arc(days: float = 14.0, case_path=ARTEMIS_CASE) -> dict:
     blunders = table.index[dop[rng.choice(dop.size, 5, replace=False)]]
     table.loc[blunders, "value"] += 30.0 * table.loc[blunders, "sigma"]
     body = case.body
-    cannonball = SolarRadiationPressure(cr_area=1.3 * 2.0 * float(body["radius_m"]) * float(body["length_m"]))
+    cannonball = SolarRadiationPressure(cr_area=1.3 * 2.0 * body.radius_m * body.length_m)
     nominal = [cannonball if isinstance(c, SolarRadiationPressure) else c for c in truth.force_model.components
                if not isinstance(c, (EmpiricalRTN, ImpulsiveManeuver))]
     t0, t1 = float(utc_to_tdb(case.start)), float(utc_to_tdb(case.end))

@@ -60,8 +60,8 @@ def test_bad_arcs_fail_alone_and_the_rest_run(tmp_path, capsys):
         str(tmp_path / "absent.toml"): f"{tmp_path / 'absent.toml'}: No such file or directory",
         str(arcs / "bad.toml"): (f"{arcs / 'bad.toml'}: 2 problems: line {line('start =')} [arc.start] "
                                  "'2020-02-30T00:00:00' is not a valid time: day out of range; "
-                                 f"line {line('mas =')} [dynamics.mas] unknown key (allowed: center, ephemeris, "
-                                 "gravity, mass, relativity, srp, third_bodies)"),
+                                 f"line {line('mas =')} [dynamics.mas] unknown key (allowed: center, drag, "
+                                 "ephemeris, gravity, mass, polynomial_acceleration, relativity, srp, third_bodies)"),
         str(arcs / "chained.toml"): "not run: it starts from bad.toml, which failed",
     }
     assert lines[4] == f"report: {tmp_path / 'night' / 'report.html'}"
