@@ -24,7 +24,7 @@ angle) and d a/d Cd = a/Cd (the estimable parameter 'cd').
 from __future__ import annotations
 
 from collections import namedtuple
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 import numpy as np
 from numba import njit
@@ -170,4 +170,5 @@ def _kernel(data, t, r, v, env, acc, grad_r, grad_v, dadp):
 
 
 DRAG = Force("drag", (AtmosphericDrag,), _compile, parameters=lambda components: ["cd"] if components else [],
+             substitute=lambda components, values: [replace(c, cd=values.get("cd", c.cd)) for c in components],
              bodies=lambda components, center: ["sun"] if components and center != "sun" else [])

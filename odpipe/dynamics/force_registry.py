@@ -93,7 +93,8 @@ class Force:
     a ForceModel lists; ``compile(components, ctx) -> data`` (components may be empty);
     ``parameters(components) -> names`` of its estimable parameters, in canonical order;
     ``bodies(components, center) -> names`` whose positions the kernel needs;
-    ``breakpoints(components) -> epochs`` where it switches on or off.
+    ``breakpoints(components) -> epochs`` where it switches on or off;
+    ``substitute(components, values) -> components`` with estimated values (by parameter name) put in.
     """
 
     name: str
@@ -102,3 +103,4 @@ class Force:
     parameters: Callable = _nothing
     bodies: Callable = _nothing
     breakpoints: Callable = _nothing
+    substitute: Callable = lambda components, values: list(components)

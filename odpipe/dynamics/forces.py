@@ -31,7 +31,7 @@ order: ``srp_scale``, ``rho_s[k]``/``rho_d[k]`` (surface k), ``cd`` (drag),
 from __future__ import annotations
 
 from collections import namedtuple
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from typing import Sequence
 
 import numpy as np
@@ -88,6 +88,15 @@ class ForceModel:
         for k, _ in enumerate(self.maneuvers()):
             names += [f"dv[{k}].{c}" for c in "xyz"] + [f"dv[{k}].t"]
         return names
+
+    def with_parameters(self, values: dict) -> "ForceModel":
+        """The same model with estimated values (by the names of :meth:`parameter_names`) in its components."""
+        comps = list(self.components)
+        for f in FORCES:
+            at = [i for i, c in enumerate(comps) if isinstance(c, f.components)]
+            for i, c in zip(at, f.substitute([comps[i] for i in at], values)):
+                comps[i] = c
+        return replace(self, components=comps)
 
     def breakpoints(self) -> list[float]:
         """Epochs where the dynamics are discontinuous (segments restart there)."""

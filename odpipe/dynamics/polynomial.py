@@ -12,7 +12,7 @@ has the estimable parameters 'poly[k].x0', 'poly[k].y0', 'poly[k].z0' (c0) and
 from __future__ import annotations
 
 from collections import namedtuple
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from typing import Sequence
 
 import numpy as np
@@ -60,6 +60,15 @@ def _kernel(data, t, r, v, env, acc, grad_r, grad_v, dadp):
                     dadp[data.param_rows[k, 3 + i], i] += dt
 
 
+def _substitute(components, values) -> list:
+    out = []
+    for k, c in enumerate(components):
+        p = [values.get(f"poly[{k}].{name}", v) for name, v in zip(PARAMETERS, (*c.c0, *c.c1))]
+        out.append(replace(c, c0=tuple(p[:3]), c1=tuple(p[3:])))
+    return out
+
+
 POLYNOMIAL = Force("polynomial", (InertialPolynomialAcceleration,), _compile, parameters=_parameters,
+                   substitute=_substitute,
                    breakpoints=lambda components: [t for p in components for t in (p.t_start, p.t_end)
                                                    if np.isfinite(t)])

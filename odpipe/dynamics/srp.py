@@ -21,7 +21,7 @@ with penumbra, multiplied over occulting bodies.
 from __future__ import annotations
 
 from collections import namedtuple
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from typing import Sequence
 
 import numpy as np
@@ -244,4 +244,10 @@ def _kernel(data, t, r, v, env, acc, grad_r, grad_v, dadp):
             dadp[data.rho_rows[k, 1]] += d_rd[k]
 
 
-SRP = Force("srp", (SolarRadiationPressure,), _compile, parameters=_parameters, bodies=_bodies)
+def _substitute(components, values) -> list:
+    return [replace(c, scale=values.get("srp_scale", c.scale),
+                    surfaces=[replace(s, rho_s=values.get(f"rho_s[{k}]", s.rho_s), rho_d=values.get(f"rho_d[{k}]", s.rho_d))
+                              for k, s in enumerate(c.surfaces)]) for c in components]
+
+
+SRP = Force("srp", (SolarRadiationPressure,), _compile, parameters=_parameters, bodies=_bodies, substitute=_substitute)

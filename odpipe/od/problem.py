@@ -7,7 +7,7 @@ and :func:`odpipe.estimation.fit.fit`. Registry entries it understands
 
 ==============  =================================================================================
 state           epoch position/velocity (``registry.add_state``), relative to the force model centre
-dynamic         a force-model parameter: ``info['model']`` in ``srp_scale``, ``rho_s[k]``, ``rho_d[k]``, ``cd``, ``poly[k].x0``..
+dynamic         a force-model parameter: ``info['model']`` in a name of ``ForceModel.parameter_names`` (``srp_scale``, ``rho_s[k]``, ``cd``, ``poly[k].x0``, ...), put in by ``ForceModel.with_parameters``
 stochastic      RTN accelerations (``registry.add_stochastic_acceleration``, axes R, T, N), m/s^2
 maneuver        impulsive ICRF dV (``registry.add_maneuver``; owner ``<sc>.<label>``), m/s
 maneuver_epoch  offset (s) of that maneuver's firing from its logged epoch (``add_maneuver(sigma_epoch=)``);
@@ -51,9 +51,7 @@ from dataclasses import dataclass, replace
 import numpy as np
 import pandas as pd
 
-from odpipe.dynamics.forces import (AtmosphericDrag, EmpiricalRTN, ForceModel, InertialPolynomialAcceleration,
-                                    SolarRadiationPressure)
-from odpipe.dynamics.polynomial import PARAMETERS as POLY_PARAMETERS
+from odpipe.dynamics.forces import EmpiricalRTN, ForceModel
 from odpipe.measurements import MeasurementSetup, compute, residuals
 
 from .segment import SegmentTrajectory
@@ -191,18 +189,7 @@ class TrackingProblem:
     def _segment_model(self, sc, x0, a, b) -> tuple[ForceModel, list, list]:
         fm, ix = self.force_models[sc], self._sc[sc]
         values = {name: x0[i] for i, name in ix["dynamic"]}
-        comps, n_poly = [], 0
-        for c in fm.components:
-            if isinstance(c, SolarRadiationPressure) and values:
-                surf = [replace(s, rho_s=values.get(f"rho_s[{k}]", s.rho_s), rho_d=values.get(f"rho_d[{k}]", s.rho_d))
-                        for k, s in enumerate(c.surfaces)]
-                c = replace(c, scale=values.get("srp_scale", c.scale), surfaces=surf)
-            elif isinstance(c, AtmosphericDrag) and "cd" in values:
-                c = replace(c, cd=values["cd"])
-            elif isinstance(c, InertialPolynomialAcceleration):
-                p = [values.get(f"poly[{n_poly}].{name}", v) for name, v in zip(POLY_PARAMETERS, (*c.c0, *c.c1))]
-                c, n_poly = replace(c, c0=tuple(p[:3]), c1=tuple(p[3:])), n_poly + 1
-            comps.append(c)
+        comps = list(fm.with_parameters(values).components)
         names = [name for _, name in ix["dynamic"]]
         idx = [i for i, _ in ix["dynamic"]]
         if ix["stochastic"]:
