@@ -24,7 +24,7 @@ import astropy_iers_data
 from odpipe.environment.eop_tides import ocean_tide_eop
 from odpipe.constants import ARCSEC, MJD_UNIX, NS_PER_DAY, NS_PER_S, SECONDS_PER_DAY, TT_MINUS_TAI_NS
 from odpipe.numerics.interpolation import lagrange4_uniform, on_uniform_grid
-from odpipe.time.leap_seconds import tai_minus_utc_ns
+from parsers.leap_seconds import tai_minus_utc_ns
 from odpipe.time.scales import as_utc_ns
 
 _MJD_1972 = 41317

@@ -21,7 +21,7 @@ import numpy as np
 
 from odpipe.constants import DAYS_PER_JULIAN_CENTURY, J2000_NS, NS_PER_DAY, TT_MINUS_TAI_NS
 from odpipe.environment.solid_tides import doodson_angles
-from odpipe.time.leap_seconds import tai_minus_utc_ns
+from parsers.leap_seconds import tai_minus_utc_ns
 from odpipe.time.scales import as_utc_ns
 
 # Doodson multipliers of (tau, s, h, p) and Schwiderski phase offset (deg), BLQ column order

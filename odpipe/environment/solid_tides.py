@@ -16,7 +16,7 @@ from __future__ import annotations
 import numpy as np
 
 from odpipe.constants import DAYS_PER_JULIAN_CENTURY, IERS2010_EARTH_RADIUS, J2000_NS, NS_PER_DAY, TT_MINUS_TAI_NS
-from odpipe.time.leap_seconds import tai_minus_utc_ns
+from parsers.leap_seconds import tai_minus_utc_ns
 from odpipe.time.scales import as_utc_ns
 
 H20, L20, H3, L3 = 0.6078, 0.0847, 0.292, 0.015  # nominal Love and Shida numbers (TN36 §7.1.1)

@@ -22,7 +22,7 @@ from odpipe.numerics.interpolation import on_uniform_grid
 from odpipe.frames.epochs import utc_and_tt
 from odpipe.frames.rotations import frame_rotation
 from odpipe.constants import ERA_RATE, J2000_JD, J2000_NS, NS_PER_DAY, SECONDS_PER_DAY
-from odpipe.time.leap_seconds import tai_minus_utc_ns
+from parsers.leap_seconds import tai_minus_utc_ns
 
 CIP_GRID_STEP_DAYS = 1.0 / 24.0
 _CIP_GRID_MIN_EPOCHS = 200

@@ -5,7 +5,7 @@ from __future__ import annotations
 import numpy as np
 
 from odpipe.constants import J2000_NS, NS_PER_DAY, SECONDS_PER_DAY, TT_MINUS_TAI_NS
-from odpipe.time.leap_seconds import tai_minus_utc_ns
+from parsers.leap_seconds import tai_minus_utc_ns
 from odpipe.time.scales import as_utc_ns, tdb_to_tt_seconds, tdb_to_utc
 
 

@@ -21,7 +21,7 @@ import numpy as np
 from odpipe.constants import (GPS_MINUS_TAI_NS, GPS_ORIGIN_NS, J2000_JD, J2000_NS, NS_PER_DAY, NS_PER_S,
                               SECONDS_PER_DAY, TT_MINUS_TAI_NS)
 from odpipe.numerics.interpolation import lagrange4_uniform
-from odpipe.time.leap_seconds import tai_minus_utc_ns, utc_ns_from_tai_ns
+from parsers.leap_seconds import tai_minus_utc_ns, utc_ns_from_tai_ns
 
 
 def as_utc_ns(epoch_utc) -> np.ndarray:

@@ -1,21 +1,18 @@
 """CCSDS epochs (YYYY-MM-DDThh:mm:ss[.f] or YYYY-DDDThh:mm:ss[.f], optional Z) <-> datetime64[ns].
 
-TAI, GPS and TT epochs are turned into UTC with the leap-second table of the
-``astropy_iers_data`` package (its Leap_Second.dat, read as a data file at run time, not
-imported). Other time systems (TDB, TCB, TCG, UT1, ...) are kept in their own scale:
-those rows' ``epoch`` is not UTC and their ``time_system`` column says so.
+TAI, GPS and TT epochs are turned into UTC with the IERS leap-second table
+(``parsers.leap_seconds``); epochs before 1972 become NaT. Other time systems (TDB, TCB,
+TCG, UT1, ...) are kept in their own scale: those rows' ``epoch`` is not UTC and their
+``time_system`` column says so.
 """
 
 from __future__ import annotations
 
-import importlib.util
-from functools import lru_cache
-from pathlib import Path
-
 import numpy as np
 import pandas as pd
 
-from odpipe.constants import GPS_MINUS_TAI_NS, MJD_ORIGIN, NS_PER_DAY, NS_PER_S, TT_MINUS_TAI_NS
+from odpipe.constants import GPS_MINUS_TAI_NS, NS_PER_S, TT_MINUS_TAI_NS
+from parsers import leap_seconds
 
 EPOCH = r"^\d{4}-(\d{2}-\d{2}|\d{3})T\d{2}:\d{2}:\d{2}(\.\d+)?$"
 
@@ -50,37 +47,24 @@ def to_text(epochs: np.ndarray) -> np.ndarray:
     return np.datetime_as_string(epochs, unit="ms" if exact_ms else "ns")
 
 
-@lru_cache(maxsize=1)
-def _leap_table() -> tuple[np.ndarray, np.ndarray]:
-    """(UTC instants of each TAI-UTC step as datetime64[ns], TAI-UTC in s) from Leap_Second.dat."""
-    spec = importlib.util.find_spec("astropy_iers_data")
-    if spec is None or not spec.submodule_search_locations:
-        raise LookupError("the astropy_iers_data package (leap-second table) is not installed")
-    path = Path(list(spec.submodule_search_locations)[0]) / "data" / "Leap_Second.dat"
-    rows = np.loadtxt(path, comments="#")
-    mjd, step = rows[:, 0], rows[:, 4]
-    start = (MJD_ORIGIN + (mjd * NS_PER_DAY).astype("timedelta64[ns]"))
-    return start, step
-
-
-def _tai_minus_utc_at_utc(utc: np.ndarray) -> np.ndarray:
-    start, step = _leap_table()
-    i = np.searchsorted(start, utc, side="right") - 1
-    return np.where(i >= 0, step[np.clip(i, 0, None)], np.nan)
-
-
 def to_utc(epochs: np.ndarray, scale: str) -> np.ndarray:
     """UTC of epochs given in TAI, GPS or TT (others are returned unchanged)."""
     if scale not in LEAP_SCALES:
         return epochs
-    tai = epochs - np.timedelta64(int(round(_FROM_TAI[scale] * 1e9)), "ns")
-    guess = tai - (_tai_minus_utc_at_utc(tai) * 1e9).astype("timedelta64[ns]")
-    return tai - (_tai_minus_utc_at_utc(guess) * 1e9).astype("timedelta64[ns]")
+    tai = (epochs - np.timedelta64(int(round(_FROM_TAI[scale] * 1e9)), "ns")).astype(np.int64)
+    ok = ~np.isnat(epochs) & leap_seconds.tabulated(tai, tai=True)
+    out = np.full(tai.shape, np.datetime64("NaT"), "datetime64[ns]")
+    out[ok] = leap_seconds.utc_ns_from_tai_ns(tai[ok]).astype("datetime64[ns]")
+    return out
 
 
 def from_utc(epochs: np.ndarray, scale: str) -> np.ndarray:
     """Epochs in ``scale`` (TAI, GPS or TT) of UTC epochs (others unchanged)."""
     if scale not in LEAP_SCALES:
         return epochs
-    tai = epochs + (_tai_minus_utc_at_utc(epochs) * 1e9).astype("timedelta64[ns]")
-    return tai + np.timedelta64(int(round(_FROM_TAI[scale] * 1e9)), "ns")
+    utc = np.asarray(epochs, "datetime64[ns]").astype(np.int64)
+    ok = ~np.isnat(epochs) & leap_seconds.tabulated(utc)
+    out = np.full(utc.shape, np.datetime64("NaT"), "datetime64[ns]")
+    tai = utc[ok] + leap_seconds.tai_minus_utc_ns(utc[ok])
+    out[ok] = (tai + int(round(_FROM_TAI[scale] * 1e9))).astype("datetime64[ns]")
+    return out

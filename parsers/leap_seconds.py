@@ -1,7 +1,8 @@
 """TAI−UTC from the IERS leap-second file shipped by ``astropy-iers-data``.
 
-The table is read from ``Leap_Second.dat`` (IERS Bulletin C history); nothing
-is typed in by hand. Only UTC since 1972-01-01 (integer leap seconds) is
+The one reader of ``Leap_Second.dat`` (IERS Bulletin C history): the time scales
+(``odpipe.time``) and the CCSDS TDM epochs (``parsers.tdm.times``) both use it;
+nothing is typed in by hand. Only UTC since 1972-01-01 (integer leap seconds) is
 supported: earlier "rubber-second" UTC raises ``ValueError``.
 """
 
@@ -43,6 +44,12 @@ def _first_error(ns: np.ndarray, bad: np.ndarray, what: str) -> ValueError:
     first = np.asarray(ns)[bad].ravel()[0]
     return ValueError(f"{what} {np.datetime64(int(first), 'ns')} is before 1972-01-01 UTC; "
                       f"TAI-UTC is only tabulated for integer-second UTC ({leap_second_file().name})")
+
+
+def tabulated(ns: np.ndarray, tai: bool = False) -> np.ndarray:
+    """True where int64 ns since 1970 (UTC, or TAI if ``tai``) fall on or after 1972-01-01 UTC."""
+    steps, dat = leap_second_table()
+    return np.asarray(ns) >= steps[0] + (dat[0] * NS_PER_S if tai else 0)
 
 
 def tai_minus_utc_ns(utc_ns: np.ndarray) -> np.ndarray:
