@@ -17,6 +17,7 @@ import numpy as np
 import pytest
 
 from odpipe.od import fit_arc
+from odpipe.od.outward import iteration_stages
 from bounds import max_z, nees, nees_mean_bounds, nees_upper, rms_bounds
 from libration_case import libration_arc
 
@@ -31,7 +32,7 @@ def fitted():
 
 def test_converges_with_weights_that_match_the_noise(fitted):
     _, sol = fitted
-    assert sol.converged and len(sol.history) <= 6
+    assert sol.converged and iteration_stages(sol.history)[-1]["iterations"] <= 6   # the whole arc's fit
     scales = sol.history[-1]["scales"]
     used = sol.residuals[sol.residuals["flags"] == 0]
     n_par = len(sol.registry)

@@ -28,6 +28,7 @@ from odpipe.estimation.maneuvers import maneuver_table
 from odpipe.estimation.registry import GaussMarkov, ParameterRegistry
 from odpipe.measurements import MeasurementSetup
 from odpipe.measurements.compute import spanning
+from odpipe.od.outward import labelled
 from odpipe.preprocess.flags import Flag
 from odpipe.tracking.timetags import interval_bounds
 from odpipe.time import utc_to_tdb
@@ -80,7 +81,8 @@ class ArcSetup:
     media_sigma: considered error of the media calibration scale (fraction of ``media_m``).
     edit_k: innovation k-sigma per iteration (last repeats); reweight: ARTEMIS data reweighting.
     sigma_scale: data-weight stages (loose to tight; see :class:`FitOptions`).
-    block: filter grid spacing (s); lookback: s of trajectory kept before each segment start.
+    block: filter grid spacing (s); measurement_epochs: every row's epoch on the grid too (one update per
+    epoch: a sequential filter's innovations); lookback: s of trajectory kept before each segment start.
     tabulate_earth_rotation: evaluate the GCRS->ITRS matrix from a per-arc Chebyshev table
     (:mod:`.rotation`, < 1e-12 rad) instead of the full model at every event.
     coarse_integration: integrator settings of the references of the fit's loose-weight stages
@@ -114,6 +116,7 @@ class ArcSetup:
     reweight: bool = FitOptions.reweight
     sigma_scale: tuple = FitOptions.sigma_scale
     block: float = FitOptions.block
+    measurement_epochs: bool = FitOptions.output_at_measurements
     lookback: float = 120.0
     growing_days: float | None = 2.0  # first span of the growing-arc start (None: fit the whole arc at once)
     tabulate_earth_rotation: bool = True
@@ -320,7 +323,8 @@ def fit_arc(table: pd.DataFrame, setup: ArcSetup, shared: dict | None = None) ->
     rows, times = select_rows(table, setup)
     reg = build_registry(setup, rows)
     options = FitOptions(max_iter=setup.max_iter, block=setup.block, edit_k=tuple(setup.edit_k),
-                         reweight=setup.reweight, sigma_scale=tuple(setup.sigma_scale))
+                         reweight=setup.reweight, sigma_scale=tuple(setup.sigma_scale),
+                         output_at_measurements=setup.measurement_epochs)
     grid, _ = build_grid(reg, setup.start, setup.end, options.block, options.extra_epochs)
 
     meas = setup.measurements
@@ -346,10 +350,13 @@ def fit_arc(table: pd.DataFrame, setup: ArcSetup, shared: dict | None = None) ->
     sig = data_sigma(used, setup.data_sigma) / np.abs(np.where(used["unit"] == "rad", 1.0, to_los[good]))
     group = (used["observable"] + ":" + used["station_rx"].astype(str)).to_numpy(object)
     obs = Observations(times[good], used["value"].to_numpy(float), sig, group)
-    x_ref = None
+    x_ref, history = None, []
     for end in growing_ends(setup):  # unstable orbits: reach the full arc through shorter ones
-        x_ref = fit(problem, obs, setup.start, end, replace(options, edit_k=(np.inf,)), x_ref=x_ref).x0
+        grown = fit(problem, obs, setup.start, end, replace(options, edit_k=(np.inf,)), x_ref=x_ref)
+        x_ref, history = grown.x0, history + labelled([{**h, "window": (setup.start, end)} for h in grown.history],
+                                                       "growing arc")
     sol = fit(problem, obs, setup.start, setup.end, options, x_ref=x_ref)
+    sol.history = history + sol.history   # every fit's iterations (odpipe.od.outward.iteration_stages)
     return _solution(setup, reg, problem, sol, rows, times, to_los, status, rows["value"].to_numpy(float) - computed)
 
 

@@ -37,6 +37,31 @@ def windows(start: float, end: float, epoch: float, half: float, factor: float) 
         half *= factor
 
 
+def labelled(history: list, fit: str) -> list:
+    """``history``'s entries, each naming the fit it belongs to (entries already named keep theirs)."""
+    return [{"fit": fit, **h} for h in history]
+
+
+def iteration_stages(history: list) -> list[dict]:
+    """Iterations per fit, in order: consecutive entries of one ``fit`` and ``window`` are one stage
+    (entries naming no fit: "whole arc"); each stage a dict of ``fit``, ``iterations`` and, where the
+    entries carry it, ``window`` (start, end) as UTC ISO strings to the second."""
+    stages: list[dict] = []
+    for h in history:
+        key = (h.get("fit", "whole arc"), tuple(h["window"]) if "window" in h else None)
+        if not stages or stages[-1]["_key"] != key:
+            stages.append({"_key": key, "fit": key[0], "iterations": 0})
+            if key[1] is not None:
+                stages[-1]["window"] = [str(u) for u in _utc_seconds(key[1])]
+        stages[-1]["iterations"] += 1
+    return [{k: v for k, v in s.items() if k != "_key"} for s in stages]
+
+
+def _utc_seconds(tdb) -> np.ndarray:
+    """TDB s as UTC datetime64 rounded to the second."""
+    return (tdb_to_utc(np.asarray(tdb, float)) + np.timedelta64(500, "ms")).astype("datetime64[s]")
+
+
 def _state_at(state: np.ndarray, t0: float, t1: float, force_model) -> np.ndarray:
     if t0 == t1:
         return state
@@ -58,12 +83,11 @@ def fit_outward(table: pd.DataFrame, setup):
         n = len(select_rows(table, sub)[0])
         if n == 0 or n == used:  # nothing new to fit in this window
             continue
-        utc = (tdb_to_utc(np.array([a, b])) + np.timedelta64(500, "ms")).astype("datetime64[s]")
-        _log.info("outward fit: %d rows of %s .. %s UTC", n, *utc)
+        _log.info("outward fit: %d rows of %s .. %s UTC", n, *_utc_seconds((a, b)))
         sol = fit_arc(table, sub)
-        history += [{**h, "window": (a, b)} for h in sol.history]
+        history += labelled([{**h, "window": (a, b)} for h in sol.history], "outward window")
         t_state, state, used = sol.epochs[0], sol.states[0], n
     _log.info("outward fit: the whole arc")
     sol = fit_arc(table, replace(base, state0=_state_at(state, t_state, setup.start, setup.force_model)))
-    sol.history = history + [{**h, "window": (setup.start, setup.end)} for h in sol.history]
+    sol.history = history + labelled([{**h, "window": (setup.start, setup.end)} for h in sol.history], "whole arc")
     return sol

@@ -357,6 +357,9 @@ class EstimationSection:
     # the epoch correction is below 1 sigma, so a far-off a priori is not fitted at full weight at once
     sigma_scale: list[float] = checked(positive, default_factory=lambda: list(FitOptions.sigma_scale))
     block: float = checked(positive, default=FitOptions.block)  # s, filter grid step
+    # every measurement epoch on the filter grid too: one update per epoch, so the innovations are a
+    # sequential filter's, measurement by measurement (Orekit's Kalman); false: the rows of a block at once
+    measurement_epochs: bool = FitOptions.output_at_measurements
     # unlogged maneuvers: the filter's innovations are always tested (findings in the report); with a sigma
     # (m/s per axis) each finding also becomes an estimated impulsive maneuver and the arc is fitted again
     detected_maneuver_sigma: float | None = checked(positive, default=None)

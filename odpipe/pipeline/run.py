@@ -26,6 +26,7 @@ from odpipe.media.apply import calibrate
 from odpipe.media.ionosphere import IonexModel
 from odpipe.media.model import MediaModel
 from odpipe.od.arc import ManeuverPlan, a_priori_reference, fit_arc
+from odpipe.od.outward import iteration_stages, labelled
 from odpipe.pipeline import setup as build
 from odpipe.pipeline.config import RunConfig, load_config
 from odpipe.pipeline.geometry import add_geometry, apparent_itrs, median_round_trip
@@ -146,14 +147,15 @@ def _run(cfg: RunConfig, attempt, log: RunLog, fingerprint: dict) -> dict:
         setup, shared = replace(setup, state0=arc.states[0], outward=None), {}
         table = media(table, a_priori_reference(setup, shared))
         log("calibrate: media again along the outward fit's orbit; the whole arc fitted again from it")
-        arc = _fit(table, setup, log, shared)
+        arc = _fit(table, setup, log, shared, after=(arc, "refit: media along the fitted orbit"))
     findings = unlogged_maneuvers(arc.residuals)
     log(f"innovation test for unlogged maneuvers: {len(findings)} finding(s)")
     sigma = cfg.estimation.detected_maneuver_sigma
     if len(findings) and sigma is not None:
         added = tuple(_detected_plan(k, f.after_tdb, f.epoch_tdb, sigma) for k, f in enumerate(findings.itertuples()))
         log(f"refit with {len(added)} detected maneuver(s) estimated ({sigma} m/s per axis a priori)")
-        arc = _fit(table, replace(setup, maneuvers=tuple(setup.maneuvers) + added), log, shared)
+        arc = _fit(table, replace(setup, maneuvers=tuple(setup.maneuvers) + added), log, shared,
+                   after=(arc, "refit: detected maneuvers estimated"))
     fit_seconds = time.perf_counter() - t0
     return _products(cfg, attempt, log, table, arc, edits, fit_seconds, findings, fingerprint, data.ramps)
 
@@ -171,13 +173,17 @@ def _detected_plan(k: int, after: float, epoch: float, sigma: float) -> Maneuver
     return ManeuverPlan(f"detected{k}", after, sigma=sigma)
 
 
-def _fit(table, setup, log, shared):
+def _fit(table, setup, log, shared, after=None):
+    """Fit the arc; ``after``: (the arc fitted before, label) of a refit, whose iterations stay first in the
+    history (the summary counts every fit's), this fit's labelled."""
     t0 = time.perf_counter()
     arc = fit_arc(table, setup, shared)
     for h in arc.history:
         log(f"fit iteration: {json.dumps(h, default=float)}", terminal=False)  # the fit logged it live
     log(f"fit: {'converged' if arc.converged else 'NOT converged'} in {len(arc.history)} iterations, "
         f"{time.perf_counter() - t0:.1f} s")
+    if after is not None:
+        arc.history = after[0].history + labelled(arc.history, after[1])
     return arc
 
 
@@ -286,13 +292,18 @@ def _sections(cfg, res, stats, per_pass, diag, edits, params, figures, findings,
 
 def _headline(summary: dict) -> dict:
     """The report's headline: the summary with its times and durations labelled."""
-    names = {"start": "start (UTC)", "end": "end (UTC)", "fit_seconds": "fit time (s)"}
-    return {names.get(k, k): v for k, v in summary.items()}
+    names = {"start": "start (UTC)", "end": "end (UTC)", "fit_seconds": "fit time (s)",
+             "iterations": "iterations (all fits)"}
+    out = {names.get(k, k): v for k, v in summary.items() if k != "iterations_per_fit"}
+    out["iterations per fit"] = "; ".join(f"{s['fit']}{' ' + ' .. '.join(s['window']) if 'window' in s else ''}: "
+                                          f"{s['iterations']}" for s in summary["iterations_per_fit"])
+    return out
 
 
 def _summary(cfg, arc, stats, fit_seconds) -> dict:
     out = {"arc": cfg.run.name, "spacecraft": cfg.arc.spacecraft, "start": cfg.arc.start, "end": cfg.arc.end,
-           "converged": bool(arc.converged), "iterations": len(arc.history), "fit_seconds": round(fit_seconds, 2)}
+           "converged": bool(arc.converged), "iterations": len(arc.history),
+           "iterations_per_fit": iteration_stages(arc.history), "fit_seconds": round(fit_seconds, 2)}
     for row in stats.itertuples(index=False):
         scale, unit = residuals.display_scale(row.observable)
         out[f"postfit RMS {row.observable} {row.station_rx} ({unit})"] = round(row.postfit_rms * scale, 5)

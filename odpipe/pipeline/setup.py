@@ -165,7 +165,8 @@ def arc_setup(cfg: RunConfig, fm: F.ForceModel, ramps, catalog: StationCatalog) 
                     doppler_bias_sigma=est.doppler_bias_sigma,
                     oscillator_sigma=None if est.oscillator_sigma is None else tuple(est.oscillator_sigma),
                     edit_k=tuple(est.edit_k), max_iter=est.max_iter, reweight=est.reweight,
-                    sigma_scale=tuple(est.sigma_scale), block=est.block)
+                    sigma_scale=tuple(est.sigma_scale), block=est.block,
+                    measurement_epochs=est.measurement_epochs)
 
 
 def bias_apriori(est) -> dict:
