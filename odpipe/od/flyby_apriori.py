@@ -1,0 +1,206 @@
+"""A priori orbit of a spacecraft approaching a planetary flyby, from its two-way Doppler and the flyby epoch.
+
+For a cruise arc with no ephemeris (e.g. MESSENGER the 1.5 days before its second Venus flyby,
+2007-06-05 23:08 UTC) the epoch state is found in three steps (SI units; times TDB s past J2000):
+
+1. **Line of sight.** The arc's 2-way Doppler, computed for a spacecraft sitting at the planet's
+   centre, gives ``y``: the spacecraft's range-rate relative to the planet (m/s,
+   :class:`odpipe.od.apriori.LineOfSight`).
+2. **Asymptote search.** Far from the planet the approach is close to the radial (rectilinear)
+   hyperbola that reaches the centre at the flyby epoch ``t_p``: ``r(t) = s * rho(t_p - t)`` with
+   ``rho = (mu/v∞²)(cosh F - 1)``, ``t_p - t = (mu/v∞³)(sinh F - F)``; ``s`` (unit vector, the
+   side the spacecraft comes from) and ``v∞`` are searched on a grid, each scored by the trimmed
+   RMS of its modelled ``y`` against the data (the diurnal parallax of the offset ``r`` orients
+   ``s`` across the line of sight). The flyby's miss distance (a planet radius) is neglected.
+3. **Refinement** of the best distinct candidates through the full force model about the planet:
+   soft-L1 least squares on the epoch state (STM Jacobian) of the line-of-sight Doppler plus two
+   pseudo-observations, the periapsis radius and epoch of the two-body hyperbola osculating at the
+   last data point (published flyby values, with their sigmas). Without them the Doppler of a
+   day leaves a valley across the line of sight in which the fit stalls at m/s residuals. Rows
+   the fitted orbit misses by many robust sigmas are flagged RESIDUAL and the fit repeated; the
+   lowest post-fit RMS wins. The arc fit (:func:`odpipe.od.arc.fit_arc`) then takes over from the
+   data alone.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, replace
+
+import numpy as np
+import pandas as pd
+
+from odpipe.dynamics.forces import ForceModel
+from odpipe.dynamics.propagator import propagate
+from odpipe.measurements import MeasurementSetup
+from odpipe.od.apriori import LineOfSight, _solve, flag_outliers, line_of_sight
+from odpipe.preprocess.flags import Flag
+
+
+@dataclass
+class FlybyApriori:
+    """Epoch state (ICRF about the planet, m, m/s) at ``epoch`` (TDB s), its post-fit RMS of the
+    used Doppler along the line of sight (m/s), the closest approach it predicts (``periapsis``
+    m from the centre at ``periapsis_epoch`` TDB s), the searched ``candidates`` and the ``rows``
+    with their flags and post-fit ``postfit_los`` (m/s)."""
+
+    epoch: float
+    state: np.ndarray
+    rms_los: float
+    periapsis: float
+    periapsis_epoch: float
+    candidates: pd.DataFrame
+    rows: pd.DataFrame
+
+
+def radial_distance(tau, mu: float, v_inf: float) -> np.ndarray:
+    """Distance (m) on the radial hyperbola (speed ``v_inf`` m/s at infinity) ``tau`` s before it reaches the centre."""
+    tau = np.asarray(tau, float)
+    m = tau * v_inf ** 3 / mu  # = sinh F - F
+    f = np.arcsinh(m) + 1.0  # Newton from above the root (sinh F - F is convex for F > 0)
+    for _ in range(60):
+        f = f - (np.sinh(f) - f - m) / (np.cosh(f) - 1.0)
+    return mu / v_inf ** 2 * (np.cosh(f) - 1.0)
+
+
+def sphere_grid(step_deg: float) -> np.ndarray:
+    """Unit vectors (K,3) spaced about ``step_deg`` on the sphere."""
+    out = []
+    for lat in np.radians(np.arange(-90.0 + step_deg / 2, 90.0, step_deg)):
+        n = max(1, int(round(360.0 * np.cos(lat) / step_deg)))
+        lon = np.arange(n) * 2 * np.pi / n
+        out.append(np.stack([np.cos(lat) * np.cos(lon), np.cos(lat) * np.sin(lon), np.full(n, np.sin(lat))], 1))
+    return np.concatenate(out)
+
+
+def asymptote_search(los: LineOfSight, t_p: float, mu: float, sides: np.ndarray, speeds, trim: float = 0.2,
+                     keep: int = 50) -> pd.DataFrame:
+    """Score radial approaches (side ``s`` from ``sides`` (K,3), speed at infinity from ``speeds`` m/s) reaching the
+    centre at ``t_p``; the ``keep`` best, best first: columns sx, sy, sz, v_inf, score (trimmed RMS of y, m/s)."""
+    ok = np.isfinite(los.y) & (los.t1 < t_p)
+    t0, t1, p0, p1, y = los.t0[ok], los.t1[ok], los.p0[ok], los.p1[ok], los.y[ok]
+    n_use = max(1, int(round((1.0 - trim) * y.size)))
+    base = (np.linalg.norm(p1, axis=1) - np.linalg.norm(p0, axis=1)) / (t1 - t0)
+    out = []
+    for v in np.atleast_1d(speeds):
+        rho0, rho1 = radial_distance(t_p - t0, mu, v), radial_distance(t_p - t1, mu, v)
+        # |p + s rho| for every side: sqrt(|p|^2 + 2 rho s.p + rho^2), (K, N)
+        n0 = np.sqrt(np.sum(p0 ** 2, 1) + 2 * rho0 * (sides @ p0.T) + rho0 ** 2)
+        n1 = np.sqrt(np.sum(p1 ** 2, 1) + 2 * rho1 * (sides @ p1.T) + rho1 ** 2)
+        r2 = ((n1 - n0) / (t1 - t0) - base - y) ** 2
+        score = np.sqrt(np.partition(r2, n_use - 1, axis=1)[:, :n_use].mean(1))
+        out.append(pd.DataFrame({"sx": sides[:, 0], "sy": sides[:, 1], "sz": sides[:, 2], "v_inf": float(v),
+                                 "score": score}))
+    return pd.concat(out, ignore_index=True).sort_values("score", kind="stable").head(keep).reset_index(drop=True)
+
+
+def approach_state(side, v_inf: float, mu: float, tau: float) -> np.ndarray:
+    """State (6,) m, m/s on the radial approach ``tau`` s before the centre, coming from ``side``."""
+    rho = radial_distance(tau, mu, v_inf)
+    s = np.asarray(side, float)
+    return np.concatenate([s * rho, -s * np.sqrt(v_inf ** 2 + 2 * mu / rho)])
+
+
+def distinct_sides(candidates: pd.DataFrame, count: int, min_angle: float = np.radians(10.0)) -> pd.DataFrame:
+    """The ``count`` best candidates whose sides differ by more than ``min_angle``."""
+    chosen = []
+    for row in candidates.itertuples():
+        s = np.array([row.sx, row.sy, row.sz])
+        if all(np.arccos(np.clip(s @ c, -1, 1)) > min_angle for _, c in chosen):
+            chosen.append((row.Index, s))
+        if len(chosen) == count:
+            break
+    return candidates.loc[[i for i, _ in chosen]]
+
+
+def closest_approach(state, start: float, t_p: float, force_model: ForceModel, window: float = 6 * 3600.0):
+    """(distance m, epoch TDB s) of the closest approach to the centre within ``window`` s of ``t_p``."""
+    traj = propagate(state, start, t_p + window, force_model, with_stm=False)
+    t = np.linspace(max(start, t_p - window), t_p + window, 20001)
+    d = np.linalg.norm(traj.state(t)[:, :3], axis=1)
+    i = int(np.argmin(d))
+    return float(d[i]), float(t[i])
+
+
+def determine_flyby_orbit(rows: pd.DataFrame, setup: MeasurementSetup, force_model: ForceModel, t_p: float,
+                          r_p: float, *, sigma_rp: float = 100e3, sigma_tp: float = 120.0, sigma_los: float = 0.01,
+                          speeds=None, step_deg: float = 3.0, n_refine: int = 3, edit_k: float = 10.0,
+                          loss_scale: float = 0.1) -> FlybyApriori:
+    """Epoch state at the start of ``rows`` (compressed 2-way Doppler, :func:`odpipe.od.apriori.doppler_rows`)
+    of a spacecraft that flies by ``force_model.center`` at ``t_p`` (TDB s) at ``r_p`` m from its centre
+    (sigmas ``sigma_rp`` m, ``sigma_tp`` s; ``sigma_los`` m/s weights the Doppler against them).
+
+    Default speed grid 3-20 km/s by 0.5 km/s; sides every ``step_deg`` deg. Rows the fitted orbit
+    misses by more than ``edit_k`` robust sigmas are flagged RESIDUAL and the fit repeated.
+    """
+    speeds = np.arange(3e3, 20.01e3, 500.0) if speeds is None else speeds
+    mu = force_model.central_gm or force_model.ephemeris.gm(force_model.center)
+    los = line_of_sight(rows, setup, force_model.center)
+    start, end = float(np.floor(los.t0.min() - 10.0)), float(np.ceil(los.t1.max() + 10.0))
+    grid = asymptote_search(los, t_p, mu, sphere_grid(step_deg), speeds)
+    tried = []
+    for cand in distinct_sides(grid, n_refine).itertuples():
+        x = approach_state([cand.sx, cand.sy, cand.sz], cand.v_inf, mu, t_p - start)
+        edited = rows.assign(flags=rows["flags"].to_numpy())
+        try:
+            for _ in range(3):  # fit, flag what the fitted orbit misses, fit again
+                ok = edited["flags"].to_numpy() == 0
+                x = refine_flyby(replace(los, y=np.where(ok, los.y, np.nan)), force_model, x, start, end, t_p, r_p,
+                                 sigma_rp, sigma_tp, sigma_los, loss_scale)
+                post = _postfit_los(los, force_model, x, start, end)
+                edited = flag_outliers(edited, np.where(ok, post, 0.0), edit_k, Flag.RESIDUAL)
+        except RuntimeError:  # the fit drove this candidate into the planet: the integrator gives up
+            continue
+        rms = float(np.sqrt(np.nanmean(post[edited["flags"].to_numpy() == 0] ** 2)))
+        tried.append((rms, x, edited.assign(postfit_los=post), cand))
+    if not tried:
+        raise RuntimeError("no approach candidate could be refined into an orbit")
+    tried.sort(key=lambda c: c[0])
+    rms, state, used, _ = tried[0]
+    r_p, t_min = closest_approach(state, start, t_p, force_model)
+    table = pd.DataFrame([{**c._asdict(), "postfit_rms": r} for r, _, _, c in tried])
+    return FlybyApriori(start, state, rms, r_p, t_min, table, used)
+
+
+def _postfit_los(los: LineOfSight, force_model: ForceModel, x, start: float, end: float) -> np.ndarray:
+    """Data minus the line-of-sight model (m/s) for epoch state ``x``."""
+    traj = propagate(x, start, end, force_model, with_stm=True)
+    y, _ = los.model(traj.state(los.t0)[:, :3], traj.state(los.t1)[:, :3], traj.stm(los.t0), traj.stm(los.t1))
+    return los.y - y
+
+
+def hyperbola_periapsis(state, mu: float) -> np.ndarray:
+    """(periapsis radius m, time to periapsis s) of the two-body hyperbola through ``state`` (m, m/s)."""
+    r, v = np.asarray(state[:3], float), np.asarray(state[3:], float)
+    rn = np.linalg.norm(r)
+    a = 1.0 / (2.0 / rn - v @ v / mu)  # negative on a hyperbola
+    e = np.linalg.norm(np.cross(v, np.cross(r, v)) / mu - r / rn)
+    cosh_f = (1.0 - rn / a) / e
+    f = np.arccosh(max(cosh_f, 1.0)) * np.sign(-(r @ v))  # > 0 while approaching
+    return np.array([a * (1.0 - e), np.sqrt(-a ** 3 / mu) * (e * np.sinh(f) - f)])
+
+
+def refine_flyby(los: LineOfSight, force_model: ForceModel, state0, start: float, end: float, t_p: float,
+                 r_p: float, sigma_rp: float, sigma_tp: float, sigma_los: float, loss_scale: float = 0.1,
+                 max_nfev: int = 50) -> np.ndarray:
+    """Epoch state fitted to line-of-sight Doppler (sigma ``sigma_los`` m/s) and to the flyby's periapsis radius
+    ``r_p`` (m, sigma ``sigma_rp``) and epoch ``t_p`` (TDB s, sigma ``sigma_tp`` s), the latter from the hyperbola
+    osculating at ``end``."""
+    mu = force_model.central_gm or force_model.ephemeris.gm(force_model.center)
+    ok = np.isfinite(los.y)
+    part = LineOfSight(los.t0[ok], los.t1[ok], los.p0[ok], los.p1[ok], los.y[ok])
+    scale = np.array([sigma_rp, sigma_tp])
+
+    def fun_jac(x):
+        traj = propagate(x, start, end, force_model, with_stm=True)
+        y, jac = part.model(traj.state(part.t0)[:, :3], traj.state(part.t1)[:, :3],
+                            traj.stm(part.t0), traj.stm(part.t1))
+        x_end, phi = traj.state(end)[0], traj.stm(np.array([end]))[0][:6, :6]
+        peri = hyperbola_periapsis(x_end, mu)
+        steps = np.array([1e3, 1e3, 1e3, 1e-2, 1e-2, 1e-2])
+        d_peri = np.stack([(hyperbola_periapsis(x_end + h * np.eye(6)[k], mu) - peri) / h
+                           for k, h in enumerate(steps)], 1)
+        pseudo = (peri - [r_p, t_p - end]) / scale
+        return (np.concatenate([(y - part.y) / sigma_los, pseudo]),
+                np.vstack([jac / sigma_los, (d_peri @ phi) / scale[:, None]]))
+
+    return _solve(fun_jac, state0, loss_scale / sigma_los, max_nfev)
