@@ -13,13 +13,11 @@ For a cruise arc with no ephemeris (e.g. MESSENGER the 1.5 days before its secon
    RMS of its modelled ``y`` against the data (the diurnal parallax of the offset ``r`` orients
    ``s`` across the line of sight). The flyby's miss distance (a planet radius) is neglected.
 3. **Refinement** of the best distinct candidates through the full force model about the planet:
-   soft-L1 least squares on the epoch state (STM Jacobian) of the line-of-sight Doppler plus two
-   pseudo-observations, the periapsis radius and epoch of the two-body hyperbola osculating at the
-   last data point (published flyby values, with their sigmas). Without them the Doppler of a
-   day leaves a valley across the line of sight in which the fit stalls at m/s residuals. Rows
-   the fitted orbit misses by many robust sigmas are flagged RESIDUAL and the fit repeated; the
-   lowest post-fit RMS wins. The arc fit (:func:`odpipe.od.arc.fit_arc`) then takes over from the
-   data alone.
+   rows off a running median of the candidate's residuals by more than ``jump`` m/s are flagged
+   BLUNDER (segments hundreds of m/s off, uplink hand-overs), then soft-L1 least squares on the
+   epoch state (:func:`refine`); rows the fitted orbit misses by many robust sigmas are flagged
+   RESIDUAL and the fit repeated. The lowest post-fit RMS wins; its closest approach is compared
+   with the published flyby. The arc fit (:func:`odpipe.od.arc.fit_arc`) takes over from there.
 """
 
 from __future__ import annotations
@@ -28,12 +26,13 @@ from dataclasses import dataclass, replace
 
 import numpy as np
 import pandas as pd
+from scipy.optimize import least_squares
 
 from odpipe.dynamics.forces import ForceModel
 from odpipe.dynamics.propagator import propagate
 from odpipe.measurements import MeasurementSetup
-from odpipe.od.apriori import LineOfSight, _solve, flag_outliers, line_of_sight
-from odpipe.preprocess.flags import Flag
+from odpipe.od.apriori import LineOfSight, flag_outliers, line_of_sight
+from odpipe.preprocess.flags import Flag, set_flag
 
 
 @dataclass
@@ -121,13 +120,11 @@ def closest_approach(state, start: float, t_p: float, force_model: ForceModel, w
     return float(d[i]), float(t[i])
 
 
-def determine_flyby_orbit(rows: pd.DataFrame, setup: MeasurementSetup, force_model: ForceModel, t_p: float,
-                          r_p: float, *, sigma_rp: float = 100e3, sigma_tp: float = 120.0, sigma_los: float = 0.01,
+def determine_flyby_orbit(rows: pd.DataFrame, setup: MeasurementSetup, force_model: ForceModel, t_p: float, *,
                           speeds=None, step_deg: float = 3.0, n_refine: int = 3, edit_k: float = 10.0,
-                          loss_scale: float = 0.1) -> FlybyApriori:
+                          jump: float = 5.0, loss_scale: float = 0.1) -> FlybyApriori:
     """Epoch state at the start of ``rows`` (compressed 2-way Doppler, :func:`odpipe.od.apriori.doppler_rows`)
-    of a spacecraft that flies by ``force_model.center`` at ``t_p`` (TDB s) at ``r_p`` m from its centre
-    (sigmas ``sigma_rp`` m, ``sigma_tp`` s; ``sigma_los`` m/s weights the Doppler against them).
+    of a spacecraft that flies by ``force_model.center`` at ``t_p`` (TDB s).
 
     Default speed grid 3-20 km/s by 0.5 km/s; sides every ``step_deg`` deg. Rows the fitted orbit
     misses by more than ``edit_k`` robust sigmas are flagged RESIDUAL and the fit repeated.
@@ -140,12 +137,14 @@ def determine_flyby_orbit(rows: pd.DataFrame, setup: MeasurementSetup, force_mod
     tried = []
     for cand in distinct_sides(grid, n_refine).itertuples():
         x = approach_state([cand.sx, cand.sy, cand.sz], cand.v_inf, mu, t_p - start)
-        edited = rows.assign(flags=rows["flags"].to_numpy())
         try:
-            for _ in range(3):  # fit, flag what the fitted orbit misses, fit again
+            miss = _postfit_los(los, force_model, x, start, end)
+            smooth = pd.Series(miss).rolling(31, center=True, min_periods=5).median().to_numpy()
+            edited = rows.assign(flags=set_flag(rows["flags"].to_numpy(np.int64), ~(np.abs(miss - smooth) <= jump),
+                                                Flag.BLUNDER))
+            for _ in range(2):  # fit, flag what the fitted orbit misses, fit again
                 ok = edited["flags"].to_numpy() == 0
-                x = refine_flyby(replace(los, y=np.where(ok, los.y, np.nan)), force_model, x, start, end, t_p, r_p,
-                                 sigma_rp, sigma_tp, sigma_los, loss_scale)
+                x = refine(replace(los, y=np.where(ok, los.y, np.nan)), force_model, x, start, end, loss_scale)
                 post = _postfit_los(los, force_model, x, start, end)
                 edited = flag_outliers(edited, np.where(ok, post, 0.0), edit_k, Flag.RESIDUAL)
         except RuntimeError:  # the fit drove this candidate into the planet: the integrator gives up
@@ -168,39 +167,25 @@ def _postfit_los(los: LineOfSight, force_model: ForceModel, x, start: float, end
     return los.y - y
 
 
-def hyperbola_periapsis(state, mu: float) -> np.ndarray:
-    """(periapsis radius m, time to periapsis s) of the two-body hyperbola through ``state`` (m, m/s)."""
-    r, v = np.asarray(state[:3], float), np.asarray(state[3:], float)
-    rn = np.linalg.norm(r)
-    a = 1.0 / (2.0 / rn - v @ v / mu)  # negative on a hyperbola
-    e = np.linalg.norm(np.cross(v, np.cross(r, v)) / mu - r / rn)
-    cosh_f = (1.0 - rn / a) / e
-    f = np.arccosh(max(cosh_f, 1.0)) * np.sign(-(r @ v))  # > 0 while approaching
-    return np.array([a * (1.0 - e), np.sqrt(-a ** 3 / mu) * (e * np.sinh(f) - f)])
 
-
-def refine_flyby(los: LineOfSight, force_model: ForceModel, state0, start: float, end: float, t_p: float,
-                 r_p: float, sigma_rp: float, sigma_tp: float, sigma_los: float, loss_scale: float = 0.1,
-                 max_nfev: int = 50) -> np.ndarray:
-    """Epoch state fitted to line-of-sight Doppler (sigma ``sigma_los`` m/s) and to the flyby's periapsis radius
-    ``r_p`` (m, sigma ``sigma_rp``) and epoch ``t_p`` (TDB s, sigma ``sigma_tp`` s), the latter from the hyperbola
-    osculating at ``end``."""
-    mu = force_model.central_gm or force_model.ephemeris.gm(force_model.center)
+def refine(los: LineOfSight, force_model: ForceModel, state0, start: float, end: float, loss_scale: float = 0.1,
+           max_nfev: int = 200) -> np.ndarray:
+    """Epoch state fitted to line-of-sight Doppler (m/s; NaN rows left out): soft-L1 least squares (scale
+    ``loss_scale`` m/s) with the STM as Jacobian and the variables scaled by it (positions are ~1e3 times
+    less determined than velocities at 0.7 AU, so unscaled steps stall)."""
     ok = np.isfinite(los.y)
     part = LineOfSight(los.t0[ok], los.t1[ok], los.p0[ok], los.p1[ok], los.y[ok])
-    scale = np.array([sigma_rp, sigma_tp])
+    cache = {}
 
     def fun_jac(x):
-        traj = propagate(x, start, end, force_model, with_stm=True)
-        y, jac = part.model(traj.state(part.t0)[:, :3], traj.state(part.t1)[:, :3],
-                            traj.stm(part.t0), traj.stm(part.t1))
-        x_end, phi = traj.state(end)[0], traj.stm(np.array([end]))[0][:6, :6]
-        peri = hyperbola_periapsis(x_end, mu)
-        steps = np.array([1e3, 1e3, 1e3, 1e-2, 1e-2, 1e-2])
-        d_peri = np.stack([(hyperbola_periapsis(x_end + h * np.eye(6)[k], mu) - peri) / h
-                           for k, h in enumerate(steps)], 1)
-        pseudo = (peri - [r_p, t_p - end]) / scale
-        return (np.concatenate([(y - part.y) / sigma_los, pseudo]),
-                np.vstack([jac / sigma_los, (d_peri @ phi) / scale[:, None]]))
+        key = x.tobytes()
+        if key not in cache:
+            traj = propagate(x, start, end, force_model, with_stm=True)
+            y, jac = part.model(traj.state(part.t0)[:, :3], traj.state(part.t1)[:, :3],
+                                traj.stm(part.t0), traj.stm(part.t1))
+            cache.clear()
+            cache[key] = (y - part.y, jac)
+        return cache[key]
 
-    return _solve(fun_jac, state0, loss_scale / sigma_los, max_nfev)
+    return least_squares(lambda x: fun_jac(x)[0], np.asarray(state0, float), jac=lambda x: fun_jac(x)[1],
+                         x_scale="jac", loss="soft_l1", f_scale=loss_scale, max_nfev=max_nfev).x
