@@ -11,7 +11,8 @@ For a cruise arc with no ephemeris (e.g. MESSENGER the 1.5 days before its secon
    ``rho = (mu/v∞²)(cosh F - 1)``, ``t_p - t = (mu/v∞³)(sinh F - F)``; ``s`` (unit vector, the
    side the spacecraft comes from) and ``v∞`` are searched on a grid, each scored by the trimmed
    RMS of its modelled ``y`` against the data (the diurnal parallax of the offset ``r`` orients
-   ``s`` across the line of sight). The flyby's miss distance (a planet radius) is neglected.
+   ``s`` across the line of sight), then the best distinct candidates are polished by least squares
+   over the side's two angles and ``v∞``. The flyby's miss distance (a planet radius) is neglected.
 3. **Refinement** of the best distinct candidates through the full force model about the planet:
    rows off a running median of the candidate's residuals by more than ``jump`` m/s are flagged
    BLUNDER (segments hundreds of m/s off, uplink hand-overs), then soft-L1 least squares on the
@@ -71,25 +72,50 @@ def sphere_grid(step_deg: float) -> np.ndarray:
     return np.concatenate(out)
 
 
+def radial_los(los: LineOfSight, t_p: float, mu: float, sides: np.ndarray, v_inf: float) -> np.ndarray:
+    """Modelled y (K, N) m/s of the radial approaches from ``sides`` (K,3) at speed ``v_inf`` (m/s at infinity)
+    reaching the centre at ``t_p``: ``|p + s rho|`` is ``sqrt(|p|² + 2 rho s.p + rho²)``."""
+    rho0, rho1 = radial_distance(t_p - los.t0, mu, v_inf), radial_distance(t_p - los.t1, mu, v_inf)
+    n0 = np.sqrt(np.sum(los.p0 ** 2, 1) + 2 * rho0 * (sides @ los.p0.T) + rho0 ** 2)
+    n1 = np.sqrt(np.sum(los.p1 ** 2, 1) + 2 * rho1 * (sides @ los.p1.T) + rho1 ** 2)
+    base = np.linalg.norm(los.p1, axis=1) - np.linalg.norm(los.p0, axis=1)
+    return (n1 - n0 - base) / (los.t1 - los.t0)
+
+
+def _usable(los: LineOfSight, t_p: float) -> LineOfSight:
+    ok = np.isfinite(los.y) & (los.t1 < t_p)
+    return LineOfSight(los.t0[ok], los.t1[ok], los.p0[ok], los.p1[ok], los.y[ok])
+
+
 def asymptote_search(los: LineOfSight, t_p: float, mu: float, sides: np.ndarray, speeds, trim: float = 0.2,
                      keep: int = 50) -> pd.DataFrame:
     """Score radial approaches (side ``s`` from ``sides`` (K,3), speed at infinity from ``speeds`` m/s) reaching the
-    centre at ``t_p``; the ``keep`` best, best first: columns sx, sy, sz, v_inf, score (trimmed RMS of y, m/s)."""
-    ok = np.isfinite(los.y) & (los.t1 < t_p)
-    t0, t1, p0, p1, y = los.t0[ok], los.t1[ok], los.p0[ok], los.p1[ok], los.y[ok]
-    n_use = max(1, int(round((1.0 - trim) * y.size)))
-    base = (np.linalg.norm(p1, axis=1) - np.linalg.norm(p0, axis=1)) / (t1 - t0)
+    centre at ``t_p``; the ``keep`` best, best first: columns sx, sy, sz, v_inf, score (trimmed RMS of y, m/s).
+    The score changes by m/s within a degree: polish the best (:func:`polish_approach`)."""
+    los = _usable(los, t_p)
+    n_use = max(1, int(round((1.0 - trim) * los.y.size)))
     out = []
     for v in np.atleast_1d(speeds):
-        rho0, rho1 = radial_distance(t_p - t0, mu, v), radial_distance(t_p - t1, mu, v)
-        # |p + s rho| for every side: sqrt(|p|^2 + 2 rho s.p + rho^2), (K, N)
-        n0 = np.sqrt(np.sum(p0 ** 2, 1) + 2 * rho0 * (sides @ p0.T) + rho0 ** 2)
-        n1 = np.sqrt(np.sum(p1 ** 2, 1) + 2 * rho1 * (sides @ p1.T) + rho1 ** 2)
-        r2 = ((n1 - n0) / (t1 - t0) - base - y) ** 2
+        r2 = (radial_los(los, t_p, mu, sides, float(v)) - los.y) ** 2
         score = np.sqrt(np.partition(r2, n_use - 1, axis=1)[:, :n_use].mean(1))
         out.append(pd.DataFrame({"sx": sides[:, 0], "sy": sides[:, 1], "sz": sides[:, 2], "v_inf": float(v),
                                  "score": score}))
     return pd.concat(out, ignore_index=True).sort_values("score", kind="stable").head(keep).reset_index(drop=True)
+
+
+def polish_approach(los: LineOfSight, t_p: float, mu: float, side, v_inf: float, loss_scale: float = 1.0):
+    """(side (3,), v_inf m/s) of the radial approach fitted to ``los`` from a grid candidate (soft-L1 least
+    squares over the side's two angles and the speed)."""
+    los = _usable(los, t_p)
+    s = np.asarray(side, float)
+
+    def unit(a):
+        return np.array([np.cos(a[1]) * np.cos(a[0]), np.cos(a[1]) * np.sin(a[0]), np.sin(a[1])])
+
+    a0 = np.array([np.arctan2(s[1], s[0]), np.arcsin(np.clip(s[2], -1, 1)), v_inf / 1e3])
+    fit = least_squares(lambda a: radial_los(los, t_p, mu, unit(a)[None, :], a[2] * 1e3)[0] - los.y, a0,
+                        loss="soft_l1", f_scale=loss_scale, diff_step=1e-7)
+    return unit(fit.x), float(fit.x[2] * 1e3)
 
 
 def approach_state(side, v_inf: float, mu: float, tau: float) -> np.ndarray:
@@ -136,7 +162,8 @@ def determine_flyby_orbit(rows: pd.DataFrame, setup: MeasurementSetup, force_mod
     grid = asymptote_search(los, t_p, mu, sphere_grid(step_deg), speeds)
     tried = []
     for cand in distinct_sides(grid, n_refine).itertuples():
-        x = approach_state([cand.sx, cand.sy, cand.sz], cand.v_inf, mu, t_p - start)
+        side, v_inf = polish_approach(los, t_p, mu, [cand.sx, cand.sy, cand.sz], cand.v_inf)
+        x = approach_state(side, v_inf, mu, t_p - start)
         try:
             miss = _postfit_los(los, force_model, x, start, end)
             smooth = pd.Series(miss).rolling(31, center=True, min_periods=5).median().to_numpy()
