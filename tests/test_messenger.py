@@ -49,34 +49,36 @@ def test_doppler_fit_converges_within_its_sigma_per_station_and_pass(fitted):
     passes = pd.read_csv(run / "residual_statistics_passes.csv")
     print(passes[["station_rx", "pass_id", "start", "end", "n_used", "n_edited", "postfit_mean", "postfit_rms"]])
     assert set(passes["station_rx"]) == {"DSS-14", "DSS-43", "DSS-63"}
-    sigma = cfg.estimation.data_sigma["doppler_2way"]
-    assert (passes["postfit_rms"] < sigma).all()  # every pass inside the stated sigma (measured 1.6-8.3 mm/s)
+    sigmas = cfg.estimation.data_sigma
+    sigma = passes["station_rx"].map(lambda st: sigmas.get(f"doppler_2way:{st}", sigmas["doppler_2way"]))
+    assert (passes["postfit_rms"] < sigma).all()  # every pass inside its station's sigma (0.02-0.48 mm/s measured)
+    assert passes.loc[passes["station_rx"] != "DSS-63", "postfit_rms"].max() < 1e-4  # at the X-band noise level
     res = pd.read_parquet(run / "residuals.parquet")
     used = res[res["flags"] == 0]
-    z = used["postfit_los"].to_numpy() / sigma
+    z = used["postfit"].to_numpy() / used["sigma"].to_numpy()
     dof = len(z) - 7  # the epoch state and the SRP scale
     assert np.sum(z ** 2) < chi2.ppf(0.999, dof)
-    assert len(used) > 0.85 * len(res)  # measured 1805 of 1986 (181 of DSS-14's first 463 edited)
+    assert len(used) == len(res)  # no innovation editing (the preprocessing flags 68 of 2053 rows)
 
 
 @pytest.mark.slow
 @pytest.mark.realdata
 def test_fitted_orbit_predicts_the_venus_flyby(fitted):
-    """Doppler of 0.7 AU away leaves the orbit ~500 km uncertain across the line of sight: the predicted
-    closest approach is within a few Venus radii and minutes of the published one (a wrong orbit of the
-    same Doppler quality misses by 10^5 km)."""
+    """The Doppler-only orbit, propagated 2 h past the last data, passes Venus within 10 km and 60 s of the
+    published flyby (measured: 338.5 km altitude at 23:08:18 UTC); orbits fitted at cm/s weights missed
+    by 6 600 km, and the a priori by 14 000 km."""
     out, cfg = fitted
     params = pd.read_csv(Path(out["run"]) / "parameters.csv").set_index("name")["estimate"]
     x0 = params[[f"236.{c}" for c in ("x", "y", "z", "vx", "vy", "vz")]].to_numpy(float)
     fm = force_model(cfg)
     t_p = tdb(FLYBY_UTC)
     traj = propagate(x0, tdb(cfg.arc.start), t_p + 3600.0, fm, with_stm=False)
-    t = np.linspace(t_p - 3600.0, t_p + 3600.0, 7201)
+    t = np.arange(t_p - 3600.0, t_p + 3600.0, 0.5)
     d = np.linalg.norm(traj.state(t)[:, :3] - fm.ephemeris.state("venus", "sun", t)[:, :3], axis=1)
     i = int(np.argmin(d))
     print(f"closest approach {d[i] / 1e3:.0f} km from Venus's centre, {t[i] - t_p:+.0f} s from {FLYBY_UTC}")
-    assert d[i] < 3 * FLYBY_RADIUS
-    assert abs(t[i] - t_p) < 600.0
+    assert abs(d[i] - FLYBY_RADIUS) < 10e3
+    assert abs(t[i] - t_p) < 60.0
 
 
 def test_radial_hyperbola_obeys_the_energy_equation():
