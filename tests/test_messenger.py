@@ -65,8 +65,8 @@ def test_doppler_fit_converges_within_its_sigma_per_station_and_pass(fitted):
 @pytest.mark.realdata
 def test_fitted_orbit_predicts_the_venus_flyby(fitted):
     """The Doppler-only orbit, propagated 2 h past the last data, passes Venus within 10 km and 60 s of the
-    published flyby (measured: 338.5 km altitude at 23:08:18 UTC); orbits fitted at cm/s weights missed
-    by 6 600 km, and the a priori (exploratory refinement, 15 900 km from the centre) by 9 500 km."""
+    published flyby (measured: 338.0 km altitude at 23:08:18 UTC); orbits fitted at cm/s weights missed
+    by 6 600 km, and the a priori (20 363 km from the centre at 22:53:29) by 14 000 km."""
     out, cfg = fitted
     params = pd.read_csv(Path(out["run"]) / "parameters.csv").set_index("name")["estimate"]
     x0 = params[[f"236.{c}" for c in ("x", "y", "z", "vx", "vy", "vz")]].to_numpy(float)
