@@ -194,7 +194,6 @@ def _postfit_los(los: LineOfSight, force_model: ForceModel, x, start: float, end
     return los.y - y
 
 
-
 def refine(los: LineOfSight, force_model: ForceModel, state0, start: float, end: float, loss_scale: float = 0.1,
            max_nfev: int = 200) -> np.ndarray:
     """Epoch state fitted to line-of-sight Doppler (m/s; NaN rows left out): soft-L1 least squares (scale
