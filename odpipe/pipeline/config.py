@@ -189,11 +189,18 @@ class SrpSection:
 
 @dataclass
 class DragSection:
-    """Atmospheric drag: Harris-Priester density, atmosphere co-rotating with the Earth (Earth-centred only)."""
+    """Atmospheric drag, atmosphere co-rotating with the Earth (Earth-centred only)."""
 
     cd: float = checked(finite)  # drag coefficient (the a priori when estimation.cd_sigma is set)
     area: float = checked(positive)  # m², cross-section
     n_bulge: float = checked(positive, default=6.0)  # Harris-Priester cosine exponent: 2 low, 6 high inclinations
+    atmosphere: Literal["harris_priester", "nrlmsise00"] = "harris_priester"  # density model
+    space_weather: Path | None = checked(readable_files, default=None)  # nrlmsise00: MSFC MSAFE F10.7/Ap table
+    solar_activity_level: Literal["95%", "50%", "5%"] = "50%"  # the table's percentile columns used
+
+    def problems(self):
+        if self.atmosphere == "nrlmsise00" and self.space_weather is None:
+            yield "space_weather", "atmosphere = \"nrlmsise00\" needs a space_weather file"
 
 
 @dataclass
