@@ -62,7 +62,7 @@ ZN3 = np.array([32.5, 20.0, 15.0, 10.0, 0.0])  # km, stratosphere/troposphere no
 ZMIX = 62.5  # km, bottom of the transition to full mixing
 ALPHA = np.array([-0.38, 0.0, 0.0, 0.0, 0.17, 0.0, -0.38, 0.0, 0.0])  # thermal diffusion, by species slot
 ALTL = np.array([200.0, 300.0, 160.0, 250.0, 240.0, 450.0, 320.0, 450.0])  # km, top of the mixing correction
-DEFAULT_SWITCHES = np.ones(24)
+SW_ON = np.ones(24)  # every switch on, daily Ap
 
 
 @njit(cache=True)
@@ -117,11 +117,13 @@ def _g0(a, p):
 def _sg0(ex, p, ap):
     """Ap-history weighted mean of _g0 over the last 57 hours (ap: daily, 4 recent 3-hourly, two 8-h means)."""
     total = 1.0 + (1.0 - ex ** 19) / (1.0 - ex) * np.sqrt(ex)
-    return (_g0(ap[1], p) + (_g0(ap[2], p) * ex + _g0(ap[3], p) * ex * ex + _g0(ap[4], p) * ex ** 3
-                             + (_g0(ap[5], p) * ex ** 4 + _g0(ap[6], p) * ex ** 12) * (1.0 - ex ** 8) / (1.0 - ex))) / total
+    recent = _g0(ap[2], p) * ex + _g0(ap[3], p) * ex * ex + _g0(ap[4], p) * ex ** 3
+    older = (_g0(ap[5], p) * ex ** 4 + _g0(ap[6], p) * ex ** 12) * (1.0 - ex ** 8) / (1.0 - ex)
+    return (_g0(ap[1], p) + recent + older) / total
 
 
-# inputs vector: doy, sec, lat, lon, lst, f107a, f107, ap, then the Legendre table and local-time terms
+# the inputs vector x: day of year, UT s, latitude deg, longitude deg, local solar time h, F10.7 81-day mean,
+# previous day's F10.7, daily Ap
 _DOY, _SEC, _LAT, _LON, _LST, _F107A, _F107, _AP = range(8)
 
 
@@ -324,8 +326,8 @@ def _splini(xa, ya, y2a, x):
         a = (xa[hi] - xx) / h
         b = (xx - xa[lo]) / h
         a2, b2 = a * a, b * b
-        total += ((1.0 - a2) * ya[lo] / 2.0 + b2 * ya[hi] / 2.0
-                  + ((-(1.0 + a2 * a2) / 4.0 + a2 / 2.0) * y2a[lo] + (b2 * b2 / 4.0 - b2 / 2.0) * y2a[hi]) * h * h / 6.0) * h
+        curvature = (-(1.0 + a2 * a2) / 4.0 + a2 / 2.0) * y2a[lo] + (b2 * b2 / 4.0 - b2 / 2.0) * y2a[hi]
+        total += ((1.0 - a2) * ya[lo] / 2.0 + b2 * ya[hi] / 2.0 + curvature * h * h / 6.0) * h
         lo += 1
     return total
 
@@ -602,7 +604,7 @@ def gtd7(doy, sec, alt_km, lat_deg, lon_deg, lst_h, f107a, f107, ap, ap_history=
     model's GTD7), H, N, anomalous O (m^-3); temperatures (2,): exospheric and at alt_km (K).
     doy day of year, sec UT seconds of day, lst_h local solar time (h), f107 the previous day's
     F10.7, f107a its 81-day mean, ap the daily Ap; ap_history (7,) when switches[9] = -1."""
-    sw_in = DEFAULT_SWITCHES if switches is None else np.asarray(switches, float)
+    sw_in = SW_ON if switches is None else np.asarray(switches, float)
     sw = np.where(sw_in == 1.0, 1.0, 0.0)
     swc = np.where(sw_in > 0.0, 1.0, 0.0)
     sw[9] = swc[9] = sw_in[9]
@@ -612,9 +614,6 @@ def gtd7(doy, sec, alt_km, lat_deg, lon_deg, lst_h, f107a, f107, ap, ap_history=
     si = d * 1.0e6
     si[5] = d[5] * 1.0e3
     return si, np.array([tinf, tz])
-
-
-SW_ON = np.ones(24)  # every switch on, daily Ap
 
 
 @njit(cache=True)
