@@ -1,6 +1,6 @@
-"""Reader of NASA MSFC's solar-activity forecast tables (MSAFE, e.g. ``Oct2010F10.txt``).
+"""Readers of space-weather tables: NASA MSFC's monthly forecasts (MSAFE) and CelesTrak's CSSI daily file.
 
-The table (after its title lines) has one row per month::
+**MSAFE** (e.g. ``Oct2010F10.txt``): the table (after its title lines) has one row per month::
 
      2010.8337   NOV   109.0      92.6      78.2       7.6       5.6       3.6
 
@@ -9,6 +9,12 @@ decimal year of the month, month abbreviation, the 13-month smoothed F10.7 solar
 the same three percentiles. A row dates the first day of its month, 00:00 UTC (its decimal
 year must agree within half a month). Lines that are not rows (titles, headers, blank) are
 skipped; a line that starts with a decimal year but is not a valid row is an error.
+
+**CSSI** (``SW-All.txt``, ``SpaceWeather-All-v1.2.txt``): one day per line in the sections
+``BEGIN OBSERVED`` and ``BEGIN DAILY_PREDICTED`` (monthly predictions are not read), in the
+columns of FORMAT(I4,I3,I3,I5,I3,8I3,I4,8I4,I4,F4.1,I2,I4,F6.1,I2,5F6.1): year, month, day, ...,
+eight 3-hourly Ap (columns 47-78), daily Ap (79-82), ..., observed F10.7 (113-118) and its
+81-day centred mean (119-124). Days must follow each other one day apart.
 """
 
 from __future__ import annotations
@@ -25,6 +31,58 @@ from parsers.fields import Fields, numbered_lines
 LEVELS = ("95%", "50%", "5%")  # percentile columns, in the file's order
 MONTHS = ("JAN", "FEB", "MAR", "APR", "MAY", "JUN", "JUL", "AUG", "SEP", "OCT", "NOV", "DEC")
 _ROW = re.compile(r"\s*\d{4}\.\d+\s")
+
+
+@dataclass(frozen=True)
+class DailyIndices:
+    """CSSI daily records: ``epoch`` datetime64[ns] UTC (day starts), observed F10.7, its 81-day
+    centred mean, daily Ap, the eight 3-hourly Ap (n, 8)."""
+
+    path: str
+    epoch: np.ndarray
+    f107: np.ndarray
+    f107_ctr81: np.ndarray
+    ap: np.ndarray
+    ap_3h: np.ndarray
+
+
+# CSSI columns (0-based slices) read: name -> (start, end)
+CSSI_COLUMNS = {"year": (0, 4), "month": (4, 7), "day": (7, 10), "ap_3h": (46, 78), "ap": (78, 82),
+                "f107": (112, 118), "f107_ctr81": (118, 124)}
+_SECTIONS = ("BEGIN OBSERVED", "BEGIN DAILY_PREDICTED")
+
+
+def read_cssi(path) -> DailyIndices:
+    """Read the observed and daily-predicted records of a CSSI space-weather file."""
+    path = Path(path)
+    inside, epochs, rows = False, [], []
+    for number, text in numbered_lines(path):
+        word = text.strip()
+        if word.startswith(("BEGIN ", "END ")):
+            inside = word in _SECTIONS
+            continue
+        if not inside or not word:
+            continue
+        f = Fields(path, number, text, fields=[text[a:b].strip() for a, b in CSSI_COLUMNS.values()], fixed=True)
+        if len(text.rstrip()) < CSSI_COLUMNS["f107_ctr81"][1]:
+            raise f.error(f"expected {CSSI_COLUMNS['f107_ctr81'][1]} columns (up to the observed 81-day F10.7), "
+                          f"found {len(text.rstrip())}")
+        try:
+            epoch = np.datetime64(f"{f.int(0, 'year'):04d}-{f.int(1, 'month'):02d}-{f.int(2, 'day'):02d}", "ns")
+        except ValueError:
+            raise f.error(f"no such date: {text[:10].strip()!r}") from None
+        if epochs and epoch != epochs[-1] + np.timedelta64(1, "D"):
+            raise f.error(f"{str(epoch)[:10]} does not follow {str(epochs[-1])[:10]} by one day")
+        ap_3h = Fields(path, number, text, fields=text[46:78].split(), fixed=True)
+        if len(ap_3h) != 8:
+            raise f.error(f"columns 47-78 must hold eight 3-hourly Ap, found {len(ap_3h)}")
+        rows.append([f.float(5, "observed F10.7"), f.float(6, "observed F10.7 81-day mean"), f.float(4, "daily Ap")]
+                    + [ap_3h.float(k, "3-hourly Ap") for k in range(8)])
+        epochs.append(epoch)
+    if not epochs:
+        raise ParseError(path, "no daily record in a BEGIN OBSERVED or BEGIN DAILY_PREDICTED section")
+    a = np.array(rows)
+    return DailyIndices(str(path), np.array(epochs, "datetime64[ns]"), a[:, 0], a[:, 1], a[:, 2], a[:, 3:])
 
 
 @dataclass(frozen=True)

@@ -8,7 +8,7 @@ from odpipe.dynamics.drag import R_EQUATOR, _space_weather_rows, nrlmsise_densit
 from odpipe.dynamics.forces import AtmosphericDrag, ForceModel, compile_model
 from odpipe.dynamics.rhs import acceleration
 from odpipe.environment.atmosphere.nrlmsise00 import gtd7
-from odpipe.environment.atmosphere.space_weather import SpaceWeather
+from odpipe.environment.atmosphere.space_weather import MonthlyForecast
 from odpipe.environment.ephemeris import Ephemeris
 from odpipe.frames.earth import itrs_to_gcrs
 from odpipe.time import utc_to_tdb
@@ -19,7 +19,7 @@ UTC = np.datetime64("2010-11-02T12:00:00", "ns")  # day 306, 43200 s UT
 
 @pytest.fixture(scope="module")
 def weather(shared_data):
-    return SpaceWeather(read_msafe(shared_data / "orekit_od" / "W3B" / "Oct2010F10.txt"))
+    return MonthlyForecast(read_msafe(shared_data / "orekit_od" / "W3B" / "Oct2010F10.txt"))
 
 
 @pytest.mark.parametrize("h_km, lon_deg", [(210.0, 30.0), (400.0, -100.0), (900.0, 170.0)])

@@ -22,7 +22,7 @@ oxygen), evaluated below 1500 km (zero above: under 1e-16 kg/m^3 there): the sam
 latitude phi_c + f sin(2 phi_c) from the ICRF latitude phi_c; longitude from the Earth rotation
 angle at UT1 = UTC (precession-nutation ignored, 0.15 deg in 2010: the model's longitude terms are
 smooth); UTC = TDB - (TT - UTC at the arc's start); local solar time UT + longitude/15 h. Solar and
-geomagnetic activity from a :class:`~odpipe.environment.atmosphere.space_weather.SpaceWeather`,
+geomagnetic activity from :mod:`~odpipe.environment.atmosphere.space_weather` (MSAFE or CSSI),
 tabulated every 3 h over the arc at compile time and interpolated linearly.
 
 Partials for the STM: d a/d v, d a/d r (through v_r, the height and, Harris-Priester, the bulge
@@ -41,7 +41,7 @@ from numba import njit
 from odpipe.constants import EARTH_ROTATION_RATE as OMEGA_EARTH, WGS84_A as R_EQUATOR, WGS84_F as FLATTENING
 from odpipe.dynamics.force_registry import Force, kernel
 from odpipe.environment.atmosphere.nrlmsise00 import mass_density
-from odpipe.environment.atmosphere.space_weather import SpaceWeather
+from odpipe.environment.atmosphere.space_weather import DailyRecords, MonthlyForecast
 from odpipe.time.scales import tdb_to_utc, utc_to_tdb, utc_to_tt
 
 BULGE_LAG = np.radians(30.0)
@@ -61,7 +61,7 @@ class AtmosphericDrag:
     area: float
     n_bulge: float = 6.0
     atmosphere: str = "harris_priester"
-    space_weather: SpaceWeather | None = None
+    space_weather: MonthlyForecast | DailyRecords | None = None
 
     def __post_init__(self):
         if self.atmosphere not in ATMOSPHERES:

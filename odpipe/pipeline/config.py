@@ -196,8 +196,8 @@ class DragSection:
     area: float = checked(positive)  # m², cross-section
     n_bulge: float = checked(positive, default=6.0)  # Harris-Priester cosine exponent: 2 low, 6 high inclinations
     atmosphere: Literal["harris_priester", "nrlmsise00"] = "harris_priester"  # density model (nrlmsise00 evaluated below 1500 km)
-    space_weather: Path | None = checked(readable_files, default=None)  # nrlmsise00: MSFC MSAFE F10.7/Ap table
-    solar_activity_level: Literal["95%", "50%", "5%"] = "50%"  # the table's percentile columns used
+    space_weather: Path | None = checked(readable_files, default=None)  # nrlmsise00: F10.7/Ap, MSFC MSAFE table or CelesTrak CSSI file
+    solar_activity_level: Literal["95%", "50%", "5%"] = "50%"  # the MSAFE table's percentile columns used
 
     def problems(self):
         if self.atmosphere == "nrlmsise00" and self.space_weather is None:

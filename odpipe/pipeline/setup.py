@@ -8,7 +8,7 @@ import pandas as pd
 from odpipe.dynamics import forces as F
 from odpipe.dynamics.propagator import propagate
 from odpipe.analysis.overlap import oem_trajectory
-from odpipe.environment.atmosphere.space_weather import SpaceWeather
+from odpipe.environment.atmosphere.space_weather import open_space_weather
 from odpipe.environment.ephemeris import Ephemeris
 from odpipe.environment.gravity import read_gravity
 from odpipe.environment.station_displacement import StationDisplacement, sites_by_station
@@ -24,7 +24,6 @@ from odpipe.operations.schema import ConfigError
 from odpipe.time import utc_to_tdb
 from parsers import blq
 from parsers.maneuvers import read_plan
-from parsers.spaceweather import read_msafe
 
 
 def tdb(utc_iso: str) -> float:
@@ -51,7 +50,7 @@ def force_model(cfg: RunConfig) -> F.ForceModel:
         comps.append(F.SolarRadiationPressure(dyn.srp.cr_area, surfaces, tuple(dyn.srp.occulters)))
     if dyn.drag is not None:
         d = dyn.drag
-        weather = SpaceWeather(read_msafe(d.space_weather, d.solar_activity_level)) if d.space_weather else None
+        weather = open_space_weather(d.space_weather, d.solar_activity_level) if d.space_weather else None
         comps.append(F.AtmosphericDrag(d.cd, d.area, d.n_bulge, d.atmosphere, weather))
     if dyn.polynomial_acceleration is not None:
         poly = dyn.polynomial_acceleration
