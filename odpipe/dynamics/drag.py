@@ -1,4 +1,4 @@
-"""Atmospheric drag with the Harris-Priester density model (Montenbruck & Gill 2000, 3.5).
+"""Atmospheric drag with the Harris-Priester (Montenbruck & Gill 2000, 3.5) or NRLMSISE-00 density.
 
 Acceleration (m/s^2) of a spacecraft of mass m at r (Earth-centred ICRF, m),
 velocity v, in an atmosphere co-rotating with the Earth (M&G eq. 3.97):
@@ -17,8 +17,17 @@ Table: M&G Table 3.8 (mean solar activity), 100-1000 km; zero density above
 order in the flattening, h = |r| - R_E (1 - f sin^2(phi)), phi the ICRF latitude
 (tens of metres from the exact geodetic height at 500 km, an 0.3 % density change).
 
-Partials for the STM: d a/d v, d a/d r (through v_r, the height and the bulge
-angle) and d a/d Cd = a/Cd (the estimable parameter 'cd').
+NRLMSISE-00 (:mod:`odpipe.environment.atmosphere.nrlmsise00`, total mass density with anomalous
+oxygen), evaluated below 1500 km (zero above: under 1e-16 kg/m^3 there): the same height; geodetic
+latitude phi_c + f sin(2 phi_c) from the ICRF latitude phi_c; longitude from the Earth rotation
+angle at UT1 = UTC (precession-nutation ignored, 0.15 deg in 2010: the model's longitude terms are
+smooth); UTC = TDB - (TT - UTC at the arc's start); local solar time UT + longitude/15 h. Solar and
+geomagnetic activity from :mod:`~odpipe.environment.atmosphere.space_weather` (MSAFE or CSSI),
+tabulated every 3 h over the arc at compile time and interpolated linearly.
+
+Partials for the STM: d a/d v, d a/d r (through v_r, the height and, Harris-Priester, the bulge
+angle; NRLMSISE-00: the height only, by a central difference of +-100 m) and d a/d Cd = a/Cd
+(the estimable parameter 'cd').
 """
 
 from __future__ import annotations
@@ -31,22 +40,41 @@ from numba import njit
 
 from odpipe.constants import EARTH_ROTATION_RATE as OMEGA_EARTH, WGS84_A as R_EQUATOR, WGS84_F as FLATTENING
 from odpipe.dynamics.force_registry import Force, kernel
+from odpipe.environment.atmosphere.nrlmsise00 import mass_density
+from odpipe.environment.atmosphere.space_weather import DailyRecords, MonthlyForecast
+from odpipe.time.scales import tdb_to_utc, utc_to_tdb, utc_to_tt
 
 BULGE_LAG = np.radians(30.0)
+ATMOSPHERES = ("harris_priester", "nrlmsise00")
+MSIS_TOP = 1500e3  # m, NRLMSISE-00 density taken as zero above
+MSIS_DH = 100.0  # m, half-step of the height difference
+SW_STEP = 10800.0  # s, space-weather tabulation step
 
 
 @dataclass
 class AtmosphericDrag:
     """Drag coefficient Cd (estimable parameter 'cd'), cross-section area (m^2);
-    Harris-Priester bulge exponent n (2 low, 6 polar orbits). Earth-centred models only."""
+    Harris-Priester bulge exponent n (2 low, 6 polar orbits); atmosphere 'harris_priester' or
+    'nrlmsise00' (which needs space_weather). Earth-centred models only."""
 
     cd: float
     area: float
     n_bulge: float = 6.0
+    atmosphere: str = "harris_priester"
+    space_weather: MonthlyForecast | DailyRecords | None = None
+
+    def __post_init__(self):
+        if self.atmosphere not in ATMOSPHERES:
+            raise ValueError(f"atmosphere must be one of {', '.join(ATMOSPHERES)}, not {self.atmosphere!r}")
+        if self.atmosphere == "nrlmsise00" and self.space_weather is None:
+            raise ValueError("the nrlmsise00 atmosphere needs a space_weather table")
 
 
-# on; Cd; area m^2; bulge exponent; env.pos row of the Sun; d a/d p row of 'cd' (-1: not estimated)
-DragData = namedtuple("DragData", ["on", "cd", "area", "n_bulge", "sun_slot", "cd_row"])
+# on; msis (NRLMSISE-00, else Harris-Priester); Cd; area m^2; bulge exponent; env.pos row of the Sun;
+# d a/d p row of 'cd' (-1: not estimated); space weather: first epoch (TDB s), step (s), rows
+# (previous day's F10.7, 81-day mean, Ap); TDB of the UTC year's start; TT - UTC (s)
+DragData = namedtuple("DragData", ["on", "msis", "cd", "area", "n_bulge", "sun_slot", "cd_row", "sw_t0", "sw_step",
+                                   "sw", "t_year", "tt_utc"])
 
 # height (km), minimum and maximum density (kg/m^3): M&G Table 3.8 (g/km^3 * 1e-12)
 HP_TABLE = np.array([
@@ -126,9 +154,40 @@ def harris_priester(r, r_sun, n_bulge):
 
 
 @njit(cache=True)
-def drag_acceleration(r, v, r_sun, cd, area, mass, n_bulge, acc, grad_r, grad_v, d_cd):
-    """Add the drag acceleration (m/s^2) to acc, its partials to grad_r, grad_v (3x3), d a/d Cd to d_cd."""
-    rho, drho = harris_priester(r, r_sun, n_bulge)
+def nrlmsise_density(t, r, sw_t0, sw_step, sw, t_year, tt_utc):
+    """NRLMSISE-00 density (kg/m^3) at r (Earth-centred ICRF, m) and TDB t; and d rho / d r (3,)."""
+    h, dh = height(r)
+    grad = np.zeros(3)
+    if h > MSIS_TOP:
+        return 0.0, grad
+    k = min(max((t - sw_t0) / sw_step, 0.0), sw.shape[0] - 1.000001)
+    i = int(k)
+    w = k - i
+    x = np.empty(8)
+    s_year = t - t_year
+    x[0] = np.floor(s_year / 86400.0) + 1.0
+    x[1] = s_year - (x[0] - 1.0) * 86400.0
+    rn = np.sqrt(np.sum(r * r))
+    lat_c = np.arcsin(r[2] / rn)
+    x[2] = np.degrees(lat_c + FLATTENING * np.sin(2.0 * lat_c))
+    era = 2.0 * np.pi * (0.7790572732640 + 1.00273781191135448 * (t - tt_utc) / 86400.0)
+    lon = np.degrees(np.arctan2(r[1], r[0]) - era) % 360.0
+    x[3] = lon - 360.0 if lon > 180.0 else lon
+    x[4] = x[1] / 3600.0 + x[3] / 15.0
+    x[5] = (1.0 - w) * sw[i, 1] + w * sw[i + 1, 1]
+    x[6] = (1.0 - w) * sw[i, 0] + w * sw[i + 1, 0]
+    x[7] = (1.0 - w) * sw[i, 2] + w * sw[i + 1, 2]
+    rho = mass_density(x, h / 1000.0)
+    drho_dh = (mass_density(x, (h + MSIS_DH) / 1000.0) - mass_density(x, (h - MSIS_DH) / 1000.0)) / (2.0 * MSIS_DH)
+    for j in range(3):
+        grad[j] = drho_dh * dh[j]
+    return rho, grad
+
+
+@njit(cache=True)
+def drag_acceleration(rho, drho, r, v, cd, area, mass, acc, grad_r, grad_v, d_cd):
+    """Add the drag acceleration (m/s^2) at density rho (kg/m^3, gradient drho) to acc, its partials
+    to grad_r, grad_v (3x3), d a/d Cd to d_cd."""
     if rho == 0.0:
         return
     vr = np.array([v[0] + OMEGA_EARTH * r[1], v[1] - OMEGA_EARTH * r[0], v[2]])
@@ -149,22 +208,39 @@ def drag_acceleration(r, v, r_sun, cd, area, mass, n_bulge, acc, grad_r, grad_v,
         grad_r[i, 1] += dav[i, 0] * OMEGA_EARTH
 
 
+def _space_weather_rows(d: AtmosphericDrag, lo: float, hi: float):
+    """First epoch, step and rows of the space weather every SW_STEP over [lo, hi]; the UTC year's start
+    (TDB s) and TT - UTC (s) at lo."""
+    if d.atmosphere != "nrlmsise00":
+        return 0.0, 1.0, np.zeros((2, 3)), 0.0, 0.0
+    n = int(np.ceil((hi - lo) / SW_STEP)) + 2
+    t = lo + SW_STEP * np.arange(n)
+    utc = tdb_to_utc(lo)
+    year = np.datetime64(str(utc.astype("datetime64[Y]")) + "-01-01T00:00:00", "ns")
+    tt_utc = float((utc_to_tt(utc) - utc) / np.timedelta64(1, "s"))
+    return lo, SW_STEP, d.space_weather.nrlmsise_inputs(t), float(utc_to_tdb(year)), tt_utc
+
+
 def _compile(components, ctx) -> DragData:
     if not components:
-        return DragData(False, 0.0, 0.0, 0.0, -1, -1)
+        return DragData(False, False, 0.0, 0.0, 0.0, -1, -1, 0.0, 1.0, np.zeros((2, 3)), 0.0, 0.0)
     if ctx.center != "earth":
         raise ValueError("atmospheric drag needs an Earth-centred force model")
     d = components[0]
-    return DragData(True, float(d.cd), float(d.area), float(d.n_bulge), ctx.slot["sun"], int(ctx.rows(["cd"])[0]))
+    return DragData(True, d.atmosphere == "nrlmsise00", float(d.cd), float(d.area), float(d.n_bulge), ctx.slot["sun"],
+                    int(ctx.rows(["cd"])[0]), *_space_weather_rows(d, ctx.lo, ctx.hi))
 
 
 @kernel(DragData)
 def _kernel(data, t, r, v, env, acc, grad_r, grad_v, dadp):
     if not data.on:
         return
+    if data.msis:
+        rho, drho = nrlmsise_density(t, r, data.sw_t0, data.sw_step, data.sw, data.t_year, data.tt_utc)
+    else:
+        rho, drho = harris_priester(r, env.pos[data.sun_slot], data.n_bulge)
     d_cd = np.zeros(3)
-    drag_acceleration(r, v, env.pos[data.sun_slot], data.cd, data.area, env.mass, data.n_bulge,
-                      acc, grad_r, grad_v, d_cd)
+    drag_acceleration(rho, drho, r, v, data.cd, data.area, env.mass, acc, grad_r, grad_v, d_cd)
     if data.cd_row >= 0:
         dadp[data.cd_row] += d_cd
 

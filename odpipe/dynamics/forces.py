@@ -10,7 +10,7 @@ A :class:`ForceModel` is a centre (NAIF name: 'earth', 'moon', 'sun', 'emb',
 * :class:`Relativity` - Schwarzschild term of the central body (:mod:`~odpipe.dynamics.relativity`);
 * :class:`SolarRadiationPressure` with :class:`Plate` and :class:`Cylinder` surfaces,
   conical shadows (:mod:`~odpipe.dynamics.srp`);
-* :class:`AtmosphericDrag` - Harris-Priester, Earth-centred models only (:mod:`~odpipe.dynamics.drag`);
+* :class:`AtmosphericDrag` - Harris-Priester or NRLMSISE-00, Earth-centred models only (:mod:`~odpipe.dynamics.drag`);
 * :class:`EmpiricalRTN` - piecewise-constant RTN accelerations (:mod:`~odpipe.dynamics.empirical`);
 * :class:`InertialPolynomialAcceleration` - constant plus linear ICRF acceleration
   (:mod:`~odpipe.dynamics.polynomial`);

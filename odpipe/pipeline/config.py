@@ -189,11 +189,19 @@ class SrpSection:
 
 @dataclass
 class DragSection:
-    """Atmospheric drag: Harris-Priester density, atmosphere co-rotating with the Earth (Earth-centred only)."""
+    """Atmospheric drag in an atmosphere co-rotating with the Earth (Earth-centred only): Harris-Priester
+    density (mean solar activity) or NRLMSISE-00 with F10.7 and Ap from a space-weather file."""
 
     cd: float = checked(finite)  # drag coefficient (the a priori when estimation.cd_sigma is set)
     area: float = checked(positive)  # m², cross-section
     n_bulge: float = checked(positive, default=6.0)  # Harris-Priester cosine exponent: 2 low, 6 high inclinations
+    atmosphere: Literal["harris_priester", "nrlmsise00"] = "harris_priester"  # density model (nrlmsise00 evaluated below 1500 km)
+    space_weather: Path | None = checked(readable_files, default=None)  # nrlmsise00: F10.7/Ap, MSFC MSAFE table or CelesTrak CSSI file
+    solar_activity_level: Literal["95%", "50%", "5%"] = "50%"  # the MSAFE table's percentile columns used
+
+    def problems(self):
+        if self.atmosphere == "nrlmsise00" and self.space_weather is None:
+            yield "space_weather", "atmosphere = \"nrlmsise00\" needs a space_weather file"
 
 
 @dataclass

@@ -8,6 +8,7 @@ import pandas as pd
 from odpipe.dynamics import forces as F
 from odpipe.dynamics.propagator import propagate
 from odpipe.analysis.overlap import oem_trajectory
+from odpipe.environment.atmosphere.space_weather import open_space_weather
 from odpipe.environment.ephemeris import Ephemeris
 from odpipe.environment.gravity import read_gravity
 from odpipe.environment.station_displacement import StationDisplacement, sites_by_station
@@ -48,7 +49,9 @@ def force_model(cfg: RunConfig) -> F.ForceModel:
             surfaces.append(F.Cylinder(axis, c.radius, c.length, c.rho_s, c.rho_d))
         comps.append(F.SolarRadiationPressure(dyn.srp.cr_area, surfaces, tuple(dyn.srp.occulters)))
     if dyn.drag is not None:
-        comps.append(F.AtmosphericDrag(dyn.drag.cd, dyn.drag.area, dyn.drag.n_bulge))
+        d = dyn.drag
+        weather = open_space_weather(d.space_weather, d.solar_activity_level) if d.space_weather else None
+        comps.append(F.AtmosphericDrag(d.cd, d.area, d.n_bulge, d.atmosphere, weather))
     if dyn.polynomial_acceleration is not None:
         poly = dyn.polynomial_acceleration
         t_ref = tdb(poly.epoch or cfg.initial_state.epoch or cfg.arc.start)

@@ -1,0 +1,1 @@
+"""Empirical atmosphere models and the solar/geomagnetic activity they take."""
