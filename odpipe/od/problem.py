@@ -59,7 +59,7 @@ from .segment import SegmentTrajectory, ShiftedSegmentTrajectory
 _LINEAR = ("bias", "station", "media")
 _REFERENCE = ("dynamic", "stochastic", "maneuver", "maneuver_epoch", "clock")
 _SUPPORTED = ("state",) + _LINEAR + _REFERENCE
-LINEAR_REUSE = 1e-4  # relative state offset up to which a coarse reference is shifted, not integrated
+LINEAR_REUSE = 1e-3  # relative state offset up to which a coarse reference is shifted, not integrated
 
 
 @dataclass

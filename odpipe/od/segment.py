@@ -150,7 +150,7 @@ class ShiftedSegmentTrajectory(SegmentTrajectory):
 
     ``x_start``: the new x(a-) (m, m/s); ``params``: the new values of ``base.param_names`` less those of the
     base. The error is second order in the offset: for a position offset ``d`` at orbit radius ``r``
-    about ``d**2 / r`` (2 cm for 200 m at the Moon's 1,800 km), so use it only where a reference need
+    about ``d**2 / r`` (2 m for 1.8 km at the Moon's 1,800 km), so use it only where a reference need
     not be exact. No force evaluation."""
 
     def __init__(self, base: SegmentTrajectory, x_start, dp):
