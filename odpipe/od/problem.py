@@ -59,7 +59,9 @@ from .segment import SegmentTrajectory, ShiftedSegmentTrajectory
 _LINEAR = ("bias", "station", "media")
 _REFERENCE = ("dynamic", "stochastic", "maneuver", "maneuver_epoch", "clock")
 _SUPPORTED = ("state",) + _LINEAR + _REFERENCE
-LINEAR_REUSE = 1e-3  # relative state offset up to which a coarse reference is shifted, not integrated
+LINEAR_REUSE = 1e-4  # relative state offset up to which a coarse reference is shifted, not integrated
+# (1e-3 took GRAIL-B 04-11's loose stages far enough off, through the STM's gradient to degree 8 only,
+# that its last stage needed two more passes)
 
 
 @dataclass

@@ -149,9 +149,10 @@ class ShiftedSegmentTrajectory(SegmentTrajectory):
     order: ``x(t) = base.x(t) + stm(t) dx(a-) + sensitivity(t) dp``, with the base's STM and sensitivities.
 
     ``x_start``: the new x(a-) (m, m/s); ``params``: the new values of ``base.param_names`` less those of the
-    base. The error is second order in the offset: for a position offset ``d`` at orbit radius ``r``
-    about ``d**2 / r`` (2 m for 1.8 km at the Moon's 1,800 km), so use it only where a reference need
-    not be exact. No force evaluation."""
+    base. The error is second order in the offset (for a position offset ``d`` at orbit radius ``r``
+    about ``d**2 / r``: 2 cm for 180 m at the Moon's 1,800 km), plus a first-order part where the STM
+    was integrated with a truncated gravity gradient (``partial_degree`` below the field's degree), so
+    use it only where a reference need not be exact. No force evaluation."""
 
     def __init__(self, base: SegmentTrajectory, x_start, dp):
         base = getattr(base, "base", base)   # always shifted from an integrated segment
