@@ -6,7 +6,7 @@
 (b) 14-day Earth-Moon L2 libration orbit: Earth 16x16 (EGM96), Moon 16x16
     (LP165P), Sun, Venus, Mars, Jupiter, Saturn, SRP, STM.
 (c) 1 day of a 55-km lunar orbit: Moon 200x200 (LP lpe200) with partials to degree
-    50, Earth and Sun point masses, STM.
+    50, and to 8 as the GRAIL nightly asks; Earth and Sun point masses, STM.
 
 Run: .venv/bin/python benchmarks/bench_dynamics.py  (compile time is reported apart).
 Each case reports wall and CPU time (the CPU time is the steadier figure on a shared machine).
@@ -115,12 +115,13 @@ def case_low_lunar(eph):
     v = np.sqrt(lpe.gm / r)
     inc = np.radians(89.0)
     x0 = np.array([r, 0.0, 0.0, 0.0, v * np.cos(inc), v * np.sin(inc)])
-    fm = ForceModel("moon", [SphericalHarmonics("moon", lpe, 200, partial_degree=50),
-                             PointMasses(["earth", "sun"])], mass=300.0, ephemeris=eph)
-    print("(c) 1 day, 55-km polar lunar orbit, Moon 200x200 (partials 50x50), Earth+Sun, STM")
-    sec, traj = timed(lambda: propagate(x0, t0, t0 + 86400.0, fm, with_stm=True, rtol=1e-11, atol=1e-6),
-                      repeat=1)
-    report("  6x6 STM", sec, traj)
+    print("(c) 1 day, 55-km polar lunar orbit, Moon 200x200, Earth+Sun, STM")
+    for partial in (50, 8):   # 8: the GRAIL nightly's partial_degree
+        fm = ForceModel("moon", [SphericalHarmonics("moon", lpe, 200, partial_degree=partial),
+                                 PointMasses(["earth", "sun"])], mass=300.0, ephemeris=eph)
+        sec, traj = timed(lambda: propagate(x0, t0, t0 + 86400.0, fm, with_stm=True, rtol=1e-11, atol=1e-6),
+                          repeat=1)
+        report(f"  6x6 STM, field partials {partial}x{partial}", sec, traj)
 
 
 def main():

@@ -1,4 +1,4 @@
-"""Where a GRAIL-B daily arc spends its time: wall seconds by pipeline stage and by fit iteration.
+"""Where a GRAIL-B daily arc spends its time: wall and CPU seconds by pipeline stage and by fit iteration.
 
     python benchmarks/profile_grail_arc.py [runs/grail_b_2012_04_10.toml] [--interval 0.002]
 
@@ -20,7 +20,9 @@ interval's wall time goes to the innermost frame that belongs to a stage:
 Frames of odpipe/frames, odpipe/time, odpipe/environment, numpy, scipy and pandas are
 passed over (they count for the stage that called them). numba kernels hold the GIL, so
 a sample lands just after the kernel returns, in the frame that called it: stages are
-right to the length of one kernel call. Time inside ``odpipe.estimation.fit.fit`` is
+right to the length of one kernel call. Each interval is counted twice: wall seconds and the
+main thread's CPU seconds (its own clock, ``time.pthread_getcpuclockid``), the steadier figure
+on a loaded machine. Time inside ``odpipe.estimation.fit.fit`` is
 also split by (fit call, iteration, weight stage). numba compilation (none when its
 cache is warm: run twice) is reported apart. Integrations and force-model evaluations
 (``Trajectory.n_eval``, independent of the machine's load) are counted by where
@@ -84,29 +86,34 @@ def fit_position(frame, calls: dict) -> tuple | None:
 
 
 class Sampler(threading.Thread):
-    """Samples the stack of thread ``ident`` every ``interval`` s; wall seconds by stage and by fit step."""
+    """Samples the stack of thread ``ident`` every ``interval`` s; wall and CPU seconds of that thread by
+    stage, CPU seconds by fit step."""
 
     def __init__(self, ident: int, interval: float):
         super().__init__(daemon=True)
         self.target, self.interval = ident, interval
+        self.clock = time.pthread_getcpuclockid(ident)
         self.by_stage = defaultdict(float)
+        self.cpu_by_stage = defaultdict(float)
         self.by_fit = defaultdict(lambda: defaultdict(float))
         self.calls: dict = {}
         self.stop = threading.Event()
 
     def run(self):
-        last = time.perf_counter()
+        last, last_cpu = time.perf_counter(), time.clock_gettime(self.clock)
         while not self.stop.wait(self.interval):
             frame = sys._current_frames().get(self.target)
-            now = time.perf_counter()
+            now, cpu = time.perf_counter(), time.clock_gettime(self.clock)
             dt, last = now - last, now
+            dc, last_cpu = cpu - last_cpu, cpu
             if frame is None:
                 continue
             stage = stage_of(frame)
             self.by_stage[stage] += dt
+            self.cpu_by_stage[stage] += dc
             pos = fit_position(frame, self.calls)
             if pos is not None:
-                self.by_fit[pos][stage] += dt
+                self.by_fit[pos][stage] += dc
 
 
 class Integrations:
@@ -165,15 +172,15 @@ def main(argv=None) -> int:
     sampler.join()
     print(f"{args.config.name}: {wall:.1f} s wall ({cpu:.1f} s CPU of this process), of which numba compiled {ct.functions} functions in "
           f"{ct.seconds:.1f} s; fit {summary.get('fit_seconds', float('nan')):.1f} s")
-    total = sum(sampler.by_stage.values())
-    print(f"\n{'stage':26s} {'s':>7s} {'share':>6s}")
+    total = sum(sampler.cpu_by_stage.values())
+    print(f"\n{'stage':26s} {'wall s':>7s} {'CPU s':>7s} {'CPU share':>9s}")
     for stage in ORDER:
-        s = sampler.by_stage.get(stage, 0.0)
+        s, c = sampler.by_stage.get(stage, 0.0), sampler.cpu_by_stage.get(stage, 0.0)
         if s:
-            print(f"{stage:26s} {s:7.2f} {s / total:6.1%}")
+            print(f"{stage:26s} {s:7.2f} {c:7.2f} {c / total:9.1%}")
     cols = [s for s in ("integration", "light time and partials", "filter", "smoother", "other")
             if any(v.get(s) for v in sampler.by_fit.values())]
-    print(f"\n{'fit call':>8s} {'iter':>4s} {'w.stage':>7s} {'total':>7s} " + " ".join(f"{c[:12]:>12s}" for c in cols))
+    print(f"\nCPU s by fit step\n{'fit call':>8s} {'iter':>4s} {'w.stage':>7s} {'total':>7s} " + " ".join(f"{c[:12]:>12s}" for c in cols))
     for (call, it, st), v in sorted(sampler.by_fit.items(), key=lambda kv: tuple(-1 if x is None else x
                                                                                  for x in kv[0])):
         print(f"{call:8d} {it if it is not None else '-':>4} {st if st is not None else '-':>7} "

@@ -166,3 +166,41 @@ def test_a_priori_reference_is_the_fits_first_reference(case):
     moved[0] += 1.0
     prob.reference(moved)
     assert prob.n_propagations == 2                     # another reference: integrated
+
+
+def test_coarse_references_near_an_integrated_one_are_shifted_not_integrated(case):
+    """While set_coarse is on, a segment starting near one integrated with the same coarse settings is
+    shifted from it to first order (no integration): against the segment integrated from the moved start
+    (state, SRP scale and dV), the shift leaves below 1e-4 of the move's own effect. A start further than
+    LINEAR_REUSE (relative) away, or the exact settings, integrates again."""
+    from odpipe.od.problem import LINEAR_REUSE
+
+    sc, reg, rows, times, x_man = case["sc"], case["reg"], case["rows"], case["times"], case["x_man"]
+    t_man = sc["t_man"]
+    coarse = {"rtol": 1e-10, "atol": 1e-5}
+    prob = TrackingProblem(reg, rows, times, {"SC": force_model()}, case["setup"].measurements, sc["t0"], sc["t1"],
+                           coarse=coarse)
+    prob.set_coarse(True)
+    _, base, _ = prob.trajectories(t_man, x_man)
+    assert prob.n_propagations == 1
+    x = x_man.copy()
+    x[:6] += [30.0, -20.0, 10.0, 3e-3, -2e-3, 1e-3]
+    x[reg.index("SC.srp_scale")] += 0.02
+    x[reg.indices("maneuver")] += [1e-4, -1e-4, 2e-4]
+    b, shifted, _ = prob.trajectories(t_man, x)
+    assert prob.n_propagations == 1 and shifted["SC"].n_eval == 0
+    exact = TrackingProblem(reg, rows, times, {"SC": force_model()}, case["setup"].measurements, sc["t0"],
+                            sc["t1"], **coarse).trajectories(t_man, x)[1]["SC"]
+    t = np.linspace(t_man - 100.0, b, 50)
+    effect = np.max(np.abs(exact.state(t)[:, :3] - base["SC"].state(t)[:, :3]))
+    error = np.max(np.abs(shifted["SC"].state(t)[:, :3] - exact.state(t)[:, :3]))
+    print(f"shifted reference: {error:.2e} m of a {effect:.1f} m change")
+    assert effect > 10.0 and error < 1e-4 * effect
+    np.testing.assert_array_equal(shifted["SC"].stm(t), base["SC"].stm(t))
+    far = x_man.copy()
+    far[3:6] *= 1.0 + 2.0 * LINEAR_REUSE
+    prob.trajectories(t_man, far)
+    assert prob.n_propagations == 2
+    prob.set_coarse(False)
+    prob.trajectories(t_man, x)
+    assert prob.n_propagations == 3

@@ -61,13 +61,15 @@ _TABLES: dict = {}  # (id(field), degree, gradient degree) -> (field, table): a 
 _TABLES_KEPT = 8
 
 
-def _field_table(field: GravityField, truncated: GravityField, degree: int, grad_degree: int):
+def _field_table(field: GravityField, degree: int, grad_degree: int):
     """:func:`field_table` of ``field`` to ``degree``, computed once and reused while the same field object
-    is compiled again (every segment of every iteration of an arc; 63 ms at degree 150)."""
+    is compiled again (every segment of every iteration of an arc; 63 ms at degree 150). ValueError
+    when ``degree`` exceeds the field's."""
     key = (id(field), degree, grad_degree)
     hit = _TABLES.get(key)
     if hit is not None and hit[0] is field:
         return hit[1]
+    truncated = field.truncated(degree)
     table = field_table(truncated.C, truncated.S, degree, grad_degree)
     while len(_TABLES) >= _TABLES_KEPT:
         _TABLES.pop(next(iter(_TABLES)))
@@ -82,15 +84,14 @@ def _compile(components, ctx) -> HarmonicsData:
     tables = []
     channels = []
     for k, s in enumerate(components):
-        g = s.field.truncated(s.degree)
         body = s.body.lower()
         rot = s.rotation or default_rotation(body)
         seg, deg = ROTATION_GRID.get(body, (3600.0, 12))
         channels.append(fit_channel(lambda t, rot=rot: np.asarray(rot(t)).reshape(-1, 9), ctx.lo, ctx.hi, seg, deg))
-        gm[k], radius[k], degree[k] = g.gm, g.radius, s.degree
+        gm[k], radius[k], degree[k] = s.field.gm, s.field.radius, s.degree
         grad_degree[k] = (s.degree if s.partial_degree is None else s.partial_degree) if ctx.with_stm else -1
         slot[k] = ctx.slot.get(body, -1) if body != ctx.center else -1
-        tables.append(_field_table(s.field, g, s.degree, int(grad_degree[k])))
+        tables.append(_field_table(s.field, s.degree, int(grad_degree[k])))
     rot_coefs, rot_meta = stack_channels(channels)
     start = np.zeros((max(1, n), max([st.size for st, _ in tables] + [1])), dtype=np.int64)
     T = np.zeros((max(1, n), ROWS, max([t.shape[1] for _, t in tables] + [1])))

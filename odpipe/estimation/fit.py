@@ -10,9 +10,10 @@ registry coordinates (the full parameter vector, state and parameters alike):
 * ``predict(t0, x0, rows) -> (computed, H)``: computed values of observation
   rows (all with ``t0 <= t < t1``) and their partials w.r.t. the vector at ``t0``.
 * optionally ``set_coarse(on)``: the fit turns it on for the passes of its loose-weight
-  stages (all but the last ``sigma_scale``), whose references need not be exact (they
-  only bring the reference near the solution), and off for the last stage and once the
-  iterations end.
+  stages (all but the last ``sigma_scale``) and for the first pass of the last stage (which
+  edits nothing), whose references need not be exact (they only bring the reference near
+  the solution), and off for the other passes of the last stage and once the iterations
+  end; a fit never ends converged on a coarse pass.
 
 The grid holds the arc ends, a regular spacing (``block`` s), the batch
 boundaries of every stochastic parameter and any extra epochs (maneuvers). At a
@@ -255,7 +256,8 @@ def fit(problem: Problem, obs: Observations, t_start: float, t_end: float,
     last_step, halvings, stage_start = None, 0, False
     coarse = getattr(problem, "set_coarse", lambda on: None)
     for it in range(options.max_iter):
-        coarse(stage < last_stage)
+        coarse_pass = stage < last_stage or stage_start
+        coarse(coarse_pass)
         sig_row = obs.sigma * np.array([scale[g] for g in obs.group]) * options.sigma_scale[stage]
         kk = np.inf if stage_start else _edit_k(options, it, prev_rms)  # a new stage's first pass edits nothing
         stage_start = False
@@ -322,7 +324,7 @@ def fit(problem: Problem, obs: Observations, t_start: float, t_end: float,
                 prev_rms *= options.sigma_scale[stage] / options.sigma_scale[stage + 1]  # in the next stage's units
                 stage, stage_start = stage + 1, True
             continue
-        if corr < options.tol_dx and rms_ok and it >= 1:
+        if corr < options.tol_dx and rms_ok and it >= 1 and not coarse_pass:
             converged = True
             break
     coarse(False)

@@ -54,11 +54,14 @@ import pandas as pd
 from odpipe.dynamics.forces import EmpiricalRTN, ForceModel
 from odpipe.measurements import MeasurementSetup, compute, residuals
 
-from .segment import SegmentTrajectory
+from .segment import SegmentTrajectory, ShiftedSegmentTrajectory
 
 _LINEAR = ("bias", "station", "media")
 _REFERENCE = ("dynamic", "stochastic", "maneuver", "maneuver_epoch", "clock")
 _SUPPORTED = ("state",) + _LINEAR + _REFERENCE
+LINEAR_REUSE = 1e-4  # relative state offset up to which a coarse reference is shifted, not integrated
+# (1e-3 took GRAIL-B 04-11's loose stages far enough off, through the STM's gradient to degree 8 only,
+# that its last stage needed two more passes)
 
 
 @dataclass
@@ -91,7 +94,10 @@ class TrackingProblem:
     "max_step": 60}``);
     coarse: integrator settings (e.g. ``{"rtol": 1e-9, "atol": 1e-5}``) of the references flown while
     :meth:`set_coarse` is on (the fit's loose-weight stages, where a reference need not be exact), for the
-    spacecraft without ``integrator`` settings; None: always the exact ones;
+    spacecraft without ``integrator`` settings; None: always the exact ones. While it is on, a segment
+    whose start state is within ``LINEAR_REUSE`` (relative) of one integrated with the same settings and
+    parameter set is shifted from it to first order (:class:`.segment.ShiftedSegmentTrajectory`: its
+    STM and sensitivities, no integration), so the loose stages after the first fly no new reference;
     shared: a dict shared by problems of one arc (e.g. the geometry step's a priori reference and the
     fit's problems): a segment integrated by one from the same start state, parameter values and
     settings is taken from it instead of integrated again (the latest per spacecraft and span is kept).
@@ -222,12 +228,27 @@ class TrackingProblem:
             held = self.shared.get((sc, a, b))
             if held is not None and held[0] == key:
                 trajs[sc] = held[1]
+            elif self._coarse and self._near(held, key, x0[ix["state"]], dt):
+                trajs[sc] = ShiftedSegmentTrajectory(held[1], x0[ix["state"]],
+                                                     x0[pidx[sc]] - np.frombuffer(held[0][1]))
             else:
                 trajs[sc] = SegmentTrajectory(x0[ix["state"]], a, b, fm, names, dv, self.lookback, dt=dt, **settings)
                 self.shared[(sc, a, b)] = (key, trajs[sc])
                 self.n_propagations += 1
             trajs[sc].preload(self.epochs[(self.epochs > a) & (self.epochs <= b)])
         return b, trajs, pidx
+
+    @staticmethod
+    def _near(held, key, x_start, dt) -> bool:
+        """Whether a coarse reference from ``x_start`` may be taken to first order from the segment ``held``
+        (key, trajectory) integrated with the same parameters and settings: offsets within
+        ``LINEAR_REUSE`` of the state (position and velocity, relative), no estimated firing epoch."""
+        if held is None or held[0][2:] != key[2:] or dt is not None:
+            return False
+        base = getattr(held[1], "base", held[1])
+        d = x_start - base.x_start
+        return bool(np.linalg.norm(d[:3]) <= LINEAR_REUSE * np.linalg.norm(base.x_start[:3])
+                    and np.linalg.norm(d[3:]) <= LINEAR_REUSE * np.linalg.norm(base.x_start[3:]))
 
     def linearized(self, a: float, x_a: np.ndarray) -> tuple[float, dict] | None:
         """(segment end b, sc -> ``states(t)`` (N, 6)) of the trajectory through ``x_a`` at ``a``, to first

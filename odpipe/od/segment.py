@@ -142,3 +142,35 @@ class SegmentTrajectory:
             x, Phi, S = self.state(ts), self.stm(ts), self.sensitivity(ts)
             inv = np.linalg.inv(Phi)
             self._memo.update({float(t): (x[i], Phi[i], inv[i], S[i]) for i, t in enumerate(ts)})
+
+
+class ShiftedSegmentTrajectory(SegmentTrajectory):
+    """A segment flown from a start state and parameters near those of an integrated ``base``, to first
+    order: ``x(t) = base.x(t) + stm(t) dx(a-) + sensitivity(t) dp``, with the base's STM and sensitivities.
+
+    ``x_start``: the new x(a-) (m, m/s); ``params``: the new values of ``base.param_names`` less those of the
+    base. The error is second order in the offset (for a position offset ``d`` at orbit radius ``r``
+    about ``d**2 / r``: 2 cm for 180 m at the Moon's 1,800 km), plus a first-order part where the STM
+    was integrated with a truncated gravity gradient (``partial_degree`` below the field's degree), so
+    use it only where a reference need not be exact. No force evaluation."""
+
+    def __init__(self, base: SegmentTrajectory, x_start, dp):
+        base = getattr(base, "base", base)   # always shifted from an integrated segment
+        self.base = base
+        self.center, self.t0, self.t1 = base.center, base.t0, base.t1
+        self.x_start = np.asarray(x_start, float).copy()
+        self.param_names, self.n_dv, self._np = base.param_names, base.n_dv, base._np
+        self._dx = self.x_start - base.x_start
+        self._dp = np.asarray(dp, float).copy()
+        self.n_eval = 0
+        self._memo = {self.t0: (self.x_start, np.eye(6), np.eye(6), np.zeros((6, len(self.param_names))))}
+
+    def state(self, t) -> np.ndarray:
+        b = self.base
+        return b.state(t) + b.stm(t) @ self._dx + b.sensitivity(t) @ self._dp
+
+    def stm(self, t) -> np.ndarray:
+        return self.base.stm(t)
+
+    def sensitivity(self, t) -> np.ndarray:
+        return self.base.sensitivity(t)
