@@ -150,7 +150,6 @@ def test_progress_goes_to_stderr_and_verbosity_flags(fake_run, tmp_path, capsys)
                                                     "debug: odpipe.pipeline.run: a detail"]
 
 
-@pytest.mark.slow
 def test_fit_iterations_are_logged_as_they_run(caplog):
     """Long fits show progress: each iteration's RMS and edits, logged by the fit as it goes."""
     import numpy as np
