@@ -16,10 +16,12 @@ $(STAMP): pyproject.toml
 demo: $(STAMP)
 	$(BIN)/odpipe demo
 
-# Test files are spread over WORKERS processes, whole files per worker (module fixtures computed once).
+# Test files are spread over WORKERS processes, whole files per worker (module fixtures computed once),
+# in tests/conftest.py's order (files with slow tests first); xdist's default would reorder them by
+# their number of tests and start the long few-test files last.
 WORKERS ?= 2
 test: $(STAMP)
-	$(BIN)/python -m pytest -q -n $(WORKERS) --dist loadfile
+	$(BIN)/python -m pytest -q -n $(WORKERS) --dist loadfile --no-loadscope-reorder
 
 bench: $(STAMP)
 	for f in benchmarks/bench_*.py; do echo "== $$f"; $(BIN)/python $$f || exit 1; done

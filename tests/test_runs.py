@@ -108,6 +108,7 @@ def _arcs(tmp_path, n, seconds, fail=()):
     return paths
 
 
+@pytest.mark.slow
 def test_one_failing_arc_does_not_stop_the_batch(tmp_path, monkeypatch):
     monkeypatch.setenv("PYTHONPATH", str(ROOT))
     from tests.batch_job import run_arc

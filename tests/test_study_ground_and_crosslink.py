@@ -97,6 +97,7 @@ def _figures(row) -> dict:
             "below100_d": row["odpipe day 3s<100 m"]}
 
 
+@pytest.mark.slow
 @pytest.mark.realdata
 def test_snapshot_of_three_schedules(scenario):
     """odpipe's 3-sigma figures of ground only, both and crosslinks only, relative 1e-3."""

@@ -123,3 +123,17 @@ def test_geocentric_tdb_minus_tt_from_hourly_values_equals_erfa():
         t = np.sort(rng.uniform(start, start + 9.5e7, 5000))
         ref = erfa.dtdb(2451545.0, t / 86400.0, 0.0, 0.0, 0.0, 0.0)
         assert np.abs(tdb_minus_tt(t) - ref).max() < 1e-14  # s
+
+
+def test_geocentric_tdb_minus_tt_extended_a_month_at_a_time_equals_erfa():
+    """Requests that widen the kept hours on either side (out of order) give ERFA's values everywhere."""
+    from odpipe.time.scales import _HourlyGeocentricDtdb
+
+    series = _HourlyGeocentricDtdb()
+    rng = np.random.default_rng(2)
+    months = 2.6e6 * np.array([5, 6, 4, 9, 0, 30, 70, 68, 72])  # s past 2006: gaps, back steps, beyond MAX_H
+    for start in 1.9e8 + months:
+        t = np.sort(rng.uniform(start, start + 2.6e6, 300))
+        ref = erfa.dtdb(2451545.0, t / 86400.0, 0.0, 0.0, 0.0, 0.0)
+        assert np.abs(series(t / 86400.0) - ref).max() < 1e-14  # s
+        assert series.values.size - 1 <= series.MAX_H  # hours

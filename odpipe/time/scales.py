@@ -72,6 +72,8 @@ class _HourlyGeocentricDtdb:
 
     Its shortest terms are far longer than an hour, so cubic interpolation between the
     hourly values errs by < 1e-15 s; the light-time loops ask for the same hours many times.
+    A request beyond the kept hours computes only the hours it adds (a month-by-month batch
+    over years costs the series once per hour, not once per hour per month).
     """
 
     PAD_H, MAX_H = 240, 24 * 366 * 5  # hours added around a request; longest span kept
@@ -84,14 +86,25 @@ class _HourlyGeocentricDtdb:
         lo, hi = int(np.floor(hours.min())) - 2, int(np.ceil(hours.max())) + 3
         last = self.first + self.values.size - 1
         if not self.values.size or lo < self.first or hi > last:
-            lo, hi = lo - self.PAD_H, hi + self.PAD_H
-            if self.values.size and max(hi, last) - min(lo, self.first) <= self.MAX_H:
-                lo, hi = min(lo, self.first), max(hi, last)
-            if hi - lo > self.MAX_H:  # epochs over many years: the series at each one
+            if hi - lo + 2 * self.PAD_H > self.MAX_H:  # epochs over many years: the series at each one
                 return erfa.dtdb(J2000_JD, hours / 24.0, 0.0, 0.0, 0.0, 0.0)
-            grid = np.arange(lo, hi + 1, dtype=float)
-            self.first, self.values = lo, erfa.dtdb(J2000_JD, grid / 24.0, 0.0, 0.0, 0.0, 0.0)
+            self._cover(lo - self.PAD_H, hi + self.PAD_H)
         return lagrange4_uniform(float(self.first), 1.0, self.values, hours)
+
+    def _cover(self, lo: int, hi: int) -> None:
+        """Keep the hours lo..hi, adding to the kept span while it stays within MAX_H."""
+        last = self.first + self.values.size - 1
+        if not self.values.size or max(hi, last) - min(lo, self.first) > self.MAX_H:
+            self.first, self.values = lo, self._series(lo, hi)
+            return
+        before = self._series(lo, self.first - 1)
+        after = self._series(last + 1, hi)
+        self.first, self.values = min(lo, self.first), np.concatenate([before, self.values, after])
+
+    @staticmethod
+    def _series(lo: int, hi: int) -> np.ndarray:
+        """ERFA dtdb (s) at TT hours lo..hi past J2000 (empty when hi < lo)."""
+        return erfa.dtdb(J2000_JD, np.arange(lo, hi + 1, dtype=float) / 24.0, 0.0, 0.0, 0.0, 0.0)
 
 
 _geocentric_dtdb = _HourlyGeocentricDtdb()
