@@ -59,6 +59,8 @@ from .segment import SegmentTrajectory, ShiftedSegmentTrajectory
 _LINEAR = ("bias", "station", "media")
 _REFERENCE = ("dynamic", "stochastic", "maneuver", "maneuver_epoch", "clock")
 _SUPPORTED = ("state",) + _LINEAR + _REFERENCE
+# a bias parameter's info key -> the row column it selects on
+_BIAS_KEYS = {"observable": "observable", "station": "station_rx", "pass_id": "pass_id", "spacecraft": "spacecraft"}
 LINEAR_REUSE = 1e-4  # relative state offset up to which a coarse reference is shifted, not integrated
 # (1e-3 took GRAIL-B 04-11's loose stages far enough off, through the STM's gradient to degree 8 only,
 # that its last stage needed two more passes)
@@ -307,11 +309,14 @@ class TrackingProblem:
             G_x[sc] = ev.partials.get(f"state:{sc}", np.zeros((m, 6)))
             G_p[sc] = ev.partials.get(f"dynamic:{sc}", np.zeros((m, len(trajs[sc].param_names))))
         params = self.registry.parameters
+        columns = {col: rows[col].to_numpy() for col in _BIAS_KEYS.values() if col in rows}
+        if any(p.kind == "bias" for p in params):
+            per_bias = (ev.partials["bias"][:, 0] if "bias" in ev.partials else np.ones(m)) \
+                / np.where(rows["unit"].to_numpy() == "rad", 1.0, ev.to_los)  # angles stay angles
         for i, p in enumerate(params):
             if p.kind == "bias":
-                sel = self._bias_rows(p, rows)
-                per = np.where(rows["unit"].to_numpy()[sel] == "rad", 1.0, ev.to_los[sel])  # angles stay angles
-                H_lin[sel, i] = ev.partials.get("bias", np.ones((m, 1)))[sel, 0] / per
+                sel = self._bias_rows(p, columns, m)
+                H_lin[sel, i] = per_bias[sel]
             elif p.kind == "station" and f"station:{p.owner}" in ev.partials:
                 H_lin[:, i] = ev.partials[f"station:{p.owner}"][:, "xyz".index(p.info["axis"])]
             elif p.kind == "media" and "media_scale" in ev.partials:
@@ -321,12 +326,12 @@ class TrackingProblem:
         return value, ev.to_los, ev.status, G_x, G_p, H_lin
 
     @staticmethod
-    def _bias_rows(p, rows) -> np.ndarray:
-        sel = np.ones(len(rows), bool)
-        for key, col in (("observable", "observable"), ("station", "station_rx"), ("pass_id", "pass_id"),
-                         ("spacecraft", "spacecraft")):
+    def _bias_rows(p, columns: dict, m: int) -> np.ndarray:
+        """Rows (of m) a bias parameter applies to, from the rows' columns as arrays."""
+        sel = np.ones(m, bool)
+        for key, col in _BIAS_KEYS.items():
             if key in p.info:
-                sel &= rows[col].to_numpy() == p.info[key]
+                sel &= columns[col] == p.info[key]
         return sel
 
     # -- the Problem protocol -------------------------------------------
