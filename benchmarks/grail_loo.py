@@ -30,6 +30,11 @@ CANDIDATES = {
     "deg100": {"dynamics.gravity.degree": "100"},
     "reweight": {"estimation.reweight": "true"},
     "edit3": {"estimation.edit_k": "[1e6, 10.0, 3.0]"},
+    # per-pass two-way Doppler biases (m/s) and per-station time-tag offsets (s), with either process noise
+    "bias": {"estimation.doppler_bias_sigma": "0.002"},
+    "timing": {"estimation.station_time_offset_sigma": "0.01"},
+    "q3e-7-bias": {"estimation.stochastic.sigma": "3e-7", "estimation.doppler_bias_sigma": "0.002"},
+    "q3e-7-timing": {"estimation.stochastic.sigma": "3e-7", "estimation.station_time_offset_sigma": "0.01"},
 }
 
 

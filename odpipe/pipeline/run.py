@@ -206,7 +206,7 @@ def _products(cfg, attempt, log, table, arc, edits, fit_seconds, findings, finge
     write_text(attempt.product("residual_statistics.csv"), stats.to_csv(index=False))
     per_pass = residuals.statistics(res, by=("station_rx", "observable", "pass_id"))
     write_text(attempt.product("residual_statistics_passes.csv"), per_pass.to_csv(index=False))
-    diag = station_diagnostics.diagnose(station_diagnostics.rows_used(res, table, ramps))
+    diag = station_diagnostics.diagnose(station_diagnostics.rows_used(res, table, ramps), params=arc.parameters)
     write_text(attempt.product("station_diagnostics.csv"), diag.to_csv(index=False))
     params = parameters.with_units(arc.parameters)
     write_text(attempt.product("parameters.csv"), params.to_csv(index=False))
