@@ -341,7 +341,7 @@ class EstimationSection:
     polynomial_sigma: list[float] | None = checked(positive, default=None)
     # m/s, a per-pass two-way Doppler bias (none: not estimated; odpipe.analysis.station_diagnostics)
     doppler_bias_sigma: float | None = checked(positive, default=ArcSetup.doppler_bias_sigma)
-    # s, a time-tag offset per receiving station, tags late (none: not estimated)
+    # s, a time-tag offset per receiving station, tags late, relative to the station with the most rows (none: not estimated)
     station_time_offset_sigma: float | None = checked(positive, default=ArcSetup.time_offset_sigma)
     # one-way Doppler's oscillator, estimated when set: sigmas of its fractional frequency offset y0 and drift
     # y1 (1/s) about the arc start, one pair for every band it drives (a priori 0: the rows' reference)
