@@ -39,6 +39,13 @@ CANDIDATES = {
     "timing": {"estimation.station_time_offset_sigma": "0.01"},
     "q3e-7-bias": {"estimation.stochastic.sigma": "3e-7", "estimation.doppler_bias_sigma": "0.002"},
     "q3e-7-timing": {"estimation.stochastic.sigma": "3e-7", "estimation.station_time_offset_sigma": "0.01"},
+    # blunders tested against the a priori orbit too (preprocess.apriori_blunder_k)
+    "apb": {"preprocess.apriori_blunder_k": "10.0"},
+    "q3e-7-apb": {"estimation.stochastic.sigma": "3e-7", "preprocess.apriori_blunder_k": "10.0"},
+    # the X-band one-way Doppler too (runs/grail_b_oneway_2012_04_10.toml's settings), the oscillator estimated
+    "oneway": {"data.observables": '["doppler_2way", "doppler_1way:X"]',
+               "estimation.data_sigma": "{ doppler_2way = 0.002, doppler_1way = 0.002 }",
+               "estimation.oscillator_sigma": "[1e-6, 1e-12]"},
 }
 
 
@@ -71,15 +78,15 @@ def main(argv=None):
     t0 = time.perf_counter()
     run_start(out / "start")
     print(f"start-up fit ready ({time.perf_counter() - t0:.0f} s)", flush=True)
-    arcs = [a for a in ORDER if not args.arcs or a in args.arcs.split(",")]
+    chosen = [a for a in ORDER if not args.arcs or a in args.arcs.split(",")]
     for cand in names:
         if args.source_from and cand != args.source_from:
-            for a in {SOURCE[a] for a in arcs} - {START} - set(arcs):
+            for a in {SOURCE[a] for a in chosen} - {START} - set(chosen):
                 link = out / cand / a
                 if not link.exists():
                     link.parent.mkdir(parents=True, exist_ok=True)
                     link.symlink_to(out / args.source_from / a)
-        run_variant(out / cand, CANDIDATES[cand], out / "start", arcs=arcs,
+        run_variant(out / cand, CANDIDATES[cand], out / "start", arcs=chosen,
                     log=lambda s: print(f"[{time.perf_counter() - t0:6.0f} s] {s}", flush=True))
         arcs, overlaps = collect(out, CANDIDATES)
         arcs.to_csv(out / "arcs.csv", index=False)

@@ -158,6 +158,8 @@ class PreprocessSection:
     partial: Literal["keep", "flag", "drop"] = "keep"
     elevation_mask_deg: float = checked(between(-90.0, 90.0), default=10.0)  # deg, at the receiving station
     blunder_k: float = checked(positive, default=10.0)  # robust sigmas of a pass's detrended values: BLUNDER
+    # robust sigmas of a pass's a priori residuals, detrended the same way: BLUNDER (none: not tested)
+    apriori_blunder_k: float | None = checked(positive, default=None)
     min_pass_samples: int = checked(at_least(1), default=10)  # passes with fewer rows are flagged SHORT_PASS
 
 

@@ -138,6 +138,11 @@ def _run(cfg: RunConfig, attempt, log: RunLog, fingerprint: dict) -> dict:
                           arc=(np.datetime64(cfg.arc.start, "ns"), np.datetime64(cfg.arc.end, "ns")))
     table, edits = edit(table, data.ramps, edit_cfg)
     log("edit: " + ", ".join(f"{r} {n}" for r, n in zip(edits["reason"], edits["rows"]) if n))
+    if pre.apriori_blunder_k is not None:
+        bad = apriori_blunders(table, apriori, setup.measurements, cfg.arc.spacecraft, pre.apriori_blunder_k,
+                               table["flags"].to_numpy() == 0)
+        table.loc[bad, "flags"] = table.loc[bad, "flags"] | int(Flag.BLUNDER)
+        log(f"edit: blunders against the a priori orbit {int(bad.sum())}")
 
     t0 = time.perf_counter()
     arc = _fit(table, setup, log, shared)
