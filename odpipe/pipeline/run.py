@@ -31,8 +31,10 @@ from odpipe.pipeline.config import RunConfig, load_config
 from odpipe.pipeline.geometry import add_geometry, apparent_itrs, median_round_trip
 from odpipe.pipeline.ingest import ingest
 from odpipe.pipeline.fitted_trajectory import fitted_segments
+from odpipe.preprocess.apriori_blunders import apriori_blunders
 from odpipe.preprocess.compress import compress
 from odpipe.preprocess.edit import EditConfig, edit
+from odpipe.preprocess.flags import Flag
 from odpipe.products import parameters, residuals
 from parsers.atomic import write_parquet, write_text
 from odpipe.products.oem import write_oem
