@@ -40,8 +40,8 @@ def ramps_of(name: str) -> pd.DataFrame:
 
 def _late_tags(station: str, offset_s: float):
     """An ingest whose ``station`` Doppler rows carry time tags ``offset_s`` late."""
-    def read(files, errors):
-        data = ingest(files, errors)
+    def read(files, errors, *spacecraft):
+        data = ingest(files, errors, *spacecraft)
         hit = (data.table["station_rx"] == station) & data.table["observable"].str.startswith("doppler")
         data.table.loc[hit, "epoch"] += np.timedelta64(int(round(offset_s * 1e9)), "ns")
         return data

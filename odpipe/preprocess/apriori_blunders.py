@@ -25,10 +25,12 @@ def apriori_blunders(rows: pd.DataFrame, trajectory, setup: MeasurementSetup, sp
     """True for the ``use`` rows whose a priori residual (along the line of sight, ``trajectory`` as the
     spacecraft's orbit) misses the quadratic through its three neighbours on both sides by more than
     ``k`` robust sigmas of its pass and link (:func:`.robust.spikes`)."""
-    ev = compute(rows, {spacecraft: trajectory}, setup)
-    _, res = residuals(rows, ev)
-    use = np.asarray(use, bool) & np.isfinite(res)
-    group = pd.factorize(rows["observable"].astype(str) + ":" + rows["station_rx"].astype(str) + ":"
-                         + rows["station_tx"].astype(str) + ":" + rows["pass_id"].astype(str))[0]
-    rank = pd.Series(rows["epoch"].to_numpy("datetime64[ns]").astype(np.int64)).groupby(group).rank(method="first")
-    return spikes((rank.to_numpy() * 1e9).astype(np.int64), res, group, k, use)
+    use = np.asarray(use, bool)
+    sub = rows[use]   # only these are computed: the other rows may lie outside the a priori orbit's span
+    _, res = residuals(sub, compute(sub, {spacecraft: trajectory}, setup))
+    group = pd.factorize(sub["observable"].astype(str) + ":" + sub["station_rx"].astype(str) + ":"
+                         + sub["station_tx"].astype(str) + ":" + sub["pass_id"].astype(str))[0]
+    rank = pd.Series(sub["epoch"].to_numpy("datetime64[ns]").astype(np.int64)).groupby(group).rank(method="first")
+    bad = np.zeros(len(rows), bool)
+    bad[np.flatnonzero(use)] = spikes((rank.to_numpy() * 1e9).astype(np.int64), res, group, k, np.isfinite(res))
+    return bad
