@@ -193,6 +193,8 @@ def test_diagnosis_says_when_the_estimated_offset_or_pass_biases_took_the_residu
     table = diagnose(rows, params=params).set_index("station")
     assert table.loc["DSS-34", "likely_cause"] == "timing_estimated" and table.loc["DSS-24", "likely_cause"] == "none"
     assert "DSS-34's residuals were explained by a time-tag offset, estimated by the fit" in summary(table.reset_index())
+    loose = params.assign(sigma=[0.02] + [1e-4] * len(bias))   # 10 +- 20 ms: not named, though it "explains"
+    assert diagnose(rows, params=loose).set_index("station").loc["DSS-34", "likely_cause"] != "timing_estimated"
     own = params.assign(name=["timing.DSS-34"] + [f"bias.doppler_2way.DSS-34.pass{p}" for p in bias])
     b = g["pass_id"].map(bias).to_numpy()
     assert estimated_terms(g, own)["pass_bias_estimated_explained"] == pytest.approx(
