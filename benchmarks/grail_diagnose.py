@@ -4,7 +4,8 @@
    :func:`odpipe.analysis.station_diagnostics.diagnose` (ramp segments from the arc's ODFs).
 2. ``--inject STATION --offset-ms DT``: the arc ``--arc`` refitted with that station's Doppler time tags
    DT late (its rows' epochs shifted as read), then diagnosed: the diagnosis should name ``timing`` at
-   that station with an offset near DT (one fit of 2-3 min).
+   that station with an offset near DT (one fit of 2-3 min). ``--candidate`` refits with a leave-one-out
+   candidate's settings (e.g. ``timing``: the station time offsets estimated) instead of the nightly's.
 
     nice .venv/bin/python benchmarks/grail_diagnose.py [--base out/grail_loo/base] [--inject DSS-34 --offset-ms 10]
 """
@@ -20,6 +21,7 @@ import pandas as pd
 
 import odpipe.pipeline.run as pipeline_run
 from grail_arcs import DAILY, RUNS, run_variant
+from grail_loo import CANDIDATES
 from odpipe.analysis.station_diagnostics import diagnose, rows_used
 from odpipe.pipeline.config import load_config
 from odpipe.pipeline.ingest import ingest
@@ -38,8 +40,8 @@ def ramps_of(name: str) -> pd.DataFrame:
 
 def _late_tags(station: str, offset_s: float):
     """An ingest whose ``station`` Doppler rows carry time tags ``offset_s`` late."""
-    def read(files, errors):
-        data = ingest(files, errors)
+    def read(files, errors, *spacecraft):
+        data = ingest(files, errors, *spacecraft)
         hit = (data.table["station_rx"] == station) & data.table["observable"].str.startswith("doppler")
         data.table.loc[hit, "epoch"] += np.timedelta64(int(round(offset_s * 1e9)), "ns")
         return data
@@ -72,6 +74,7 @@ def main(argv=None):
     ap.add_argument("--arc", default="grail_b_2012_04_10")
     ap.add_argument("--inject", default="")
     ap.add_argument("--offset-ms", type=float, default=10.0)
+    ap.add_argument("--candidate", default="base", help="the leave-one-out candidate whose settings the refit uses")
     ap.add_argument("--signatures", default="", help="STATION: add each fault's signature to its residuals")
     args = ap.parse_args(argv)
     base, out = args.base.resolve(), args.out.resolve()
@@ -92,7 +95,7 @@ def main(argv=None):
             sig.to_csv(out / f"signatures_{args.arc}_{args.signatures}.csv", index=False)
             print(sig.round(3).to_string(index=False))
         if args.inject:
-            folder = out / f"{args.inject}_{args.offset_ms:g}ms"
+            folder = out / f"{args.inject}_{args.offset_ms:g}ms_{args.candidate}"
             source = "grail_b_2012_04_09" if args.arc == "grail_b_2012_04_10" else None
             if source and not (folder / source).exists():
                 folder.mkdir(parents=True, exist_ok=True)
@@ -100,7 +103,7 @@ def main(argv=None):
             saved = pipeline_run.ingest
             pipeline_run.ingest = _late_tags(args.inject, args.offset_ms / 1e3)
             try:
-                run_variant(folder, {}, base.parent / "start", arcs=(args.arc,))
+                run_variant(folder, CANDIDATES[args.candidate], base.parent / "start", arcs=(args.arc,))
             finally:
                 pipeline_run.ingest = saved
             run = folder / args.arc / "current"

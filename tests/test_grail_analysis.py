@@ -170,3 +170,32 @@ def test_segments_of_stations_without_ramps_are_none():
     ramps = pd.DataFrame({"station": ["DSS-24"], "start": [t - np.timedelta64(600, "s")],
                           "end": [t + np.timedelta64(600, "s")]}, index=[7])
     assert list(_segments(trk, ramps)) == [7, -1]
+
+
+def test_diagnosis_says_when_the_estimated_offset_or_pass_biases_took_the_residuals():
+    """A station whose residuals were a 10-ms tag offset (r = -a dt) on field-like ones, fitted away by the
+    run's own time offset (the post-fit r is the field-like part): the diagnosis gives that offset back and
+    the share of r0 = r + (-a dt) it took, |r0|^2 - |r|^2 over |r0|^2; the same for per-pass biases."""
+    from odpipe.analysis.station_diagnostics import estimated_terms, summary
+
+    rng = np.random.default_rng(5)
+    rows = pd.concat([_smooth_station(rng, s, amp=3e-4) for s in ("DSS-24", "DSS-34")], ignore_index=True)
+    g = rows[rows["station"] == "DSS-34"]
+    dt, bias = 0.01, {p: 1e-3 * (k + 1) for k, p in enumerate(np.unique(g["pass_id"]))}
+    params = pd.DataFrame({"name": ["timing.DSS-34"] + [f"bias.doppler_2way.DSS-54.pass{p}" for p in bias],
+                           "kind": ["timing"] + ["bias"] * len(bias), "estimate": [dt, *bias.values()],
+                           "sigma": [1e-3] + [1e-4] * len(bias)})
+    r0 = g["r"].to_numpy() - g["acc"].to_numpy() * dt
+    got = estimated_terms(g, params)
+    assert got["timing_estimated_ms"] == pytest.approx(10.0) and got["timing_estimated_sigma_ms"] == pytest.approx(1.0)
+    assert got["timing_estimated_explained"] == pytest.approx(1 - np.sum(g["r"] ** 2) / np.sum(r0 ** 2))
+    assert got["timing_estimated_explained"] > 0.5 and got["pass_bias_estimated_explained"] == 0.0
+    table = diagnose(rows, params=params).set_index("station")
+    assert table.loc["DSS-34", "likely_cause"] == "timing_estimated" and table.loc["DSS-24", "likely_cause"] == "none"
+    assert "DSS-34's residuals were explained by a time-tag offset, estimated by the fit" in summary(table.reset_index())
+    loose = params.assign(sigma=[0.02] + [1e-4] * len(bias))   # 10 +- 20 ms: not named, though it "explains"
+    assert diagnose(rows, params=loose).set_index("station").loc["DSS-34", "likely_cause"] != "timing_estimated"
+    own = params.assign(name=["timing.DSS-34"] + [f"bias.doppler_2way.DSS-34.pass{p}" for p in bias])
+    b = g["pass_id"].map(bias).to_numpy()
+    assert estimated_terms(g, own)["pass_bias_estimated_explained"] == pytest.approx(
+        1 - np.sum(g["r"] ** 2) / np.sum((g["r"].to_numpy() + b) ** 2))

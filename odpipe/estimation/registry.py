@@ -19,6 +19,7 @@ KINDS = (
     "stochastic",   # stochastic acceleration (m/s^2), piecewise constant over batches
     "bias",         # measurement bias per pass/station/observable (observable units)
     "clock",        # clock offset/drift
+    "timing",       # a station's time-tag offset (s, tags late)
     "maneuver",     # impulsive maneuver dV component (m/s)
     "maneuver_epoch",  # impulsive maneuver epoch offset (s)
     "station",      # station coordinate (m)
@@ -114,6 +115,11 @@ class ParameterRegistry:
         if sigma_epoch is not None:
             self.add(f"{owner}.dt", "maneuver_epoch", 0.0, sigma_epoch,
                      owner=owner, epoch=epoch)
+
+    def add_time_offset(self, station, sigma, **info):
+        """Time-tag offset (s) of ``station``'s rows, positive when its tags are late (the row at tag t
+        saw t - dt); ``info`` narrows the rows as a bias's does (``observable``, ``spacecraft``)."""
+        self.add(f"timing.{station}", "timing", 0.0, sigma, owner=station, station=station, **info)
 
     # -- reading --------------------------------------------------------
     @property

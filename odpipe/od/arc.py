@@ -75,6 +75,9 @@ class ArcSetup:
     coefficients (None: fixed; a priori the model's values).
     outward: (epoch TDB s, first half-window s, factor): fit outward from that epoch (:mod:`.outward`).
     doppler_bias_sigma: per pass and receiving station, two-way Doppler (m/s along the line of sight; None: none).
+    time_offset_sigma: a time-tag offset per receiving station (s, tags late; None: none), relative to the
+    station with the most rows, whose own is zero: an offset common to every station moves the whole data set
+    in time, which the epoch state absorbs (the orbit flown that much earlier).
     oscillator_sigma: (y0, y1 1/s) sigmas of the one-way oscillator's fractional frequency offset and drift,
     when doppler_1way is fitted (a priori and reference epoch from ``measurements.oscillators``).
     station_sigma: considered (not estimated) error of each station's ITRS coordinates (m per axis).
@@ -104,6 +107,7 @@ class ArcSetup:
     range_bias_sigma: float | None = 5.0
     range_bias_per: str = "pass"
     doppler_bias_sigma: float | None = None
+    time_offset_sigma: float | None = None
     angle_bias_sigma: float | None = None
     bias_apriori: dict = field(default_factory=dict)
     cd_sigma: float | None = None
@@ -238,6 +242,10 @@ def build_registry(setup: ArcSetup, rows: pd.DataFrame) -> ParameterRegistry:
             if pid >= 0:
                 info["pass_id"] = pid
             reg.add(f"bias.{obs}.{st}.pass{pid}", "bias", _bias_apriori(setup, obs, st), sigma, owner=st, **info)
+    if setup.time_offset_sigma is not None:   # relative to the station with the most rows (a common offset is the orbit's)
+        counts = rows.loc[rows["station_rx"] != "", "station_rx"].value_counts()
+        for st in sorted(counts.index[1:]):
+            reg.add_time_offset(st, setup.time_offset_sigma, spacecraft=sc)
     if setup.angle_bias_sigma is not None:
         ang = rows[rows["unit"] == "rad"]
         for obs, st in ang[["observable", "station_rx"]].drop_duplicates().itertuples(index=False):

@@ -18,6 +18,8 @@ clock           one-way oscillator: ``info['oscillator']`` 'y0' (fractional freq
 bias            measurement bias along the line of sight (m for range, m/s for Doppler; an angle in rad for
                 angle rows, unit 'rad') of the rows matching ``info`` keys ``observable``, ``station``
                 (receiver), ``pass_id``, ``spacecraft``
+timing          time-tag offset (s, tags late) of the rows matching ``info`` as a bias's; partial minus the
+                computed value's rate (:func:`odpipe.measurements.timetag.tag_rate`)
 station         ITRS offset (m) of station ``owner`` from the catalog, ``info['axis']`` x/y/z (linear)
 media           offset of the media scale from ``setup.media_scale`` (linear, exact)
 ==============  =================================================================================
@@ -53,10 +55,11 @@ import pandas as pd
 
 from odpipe.dynamics.forces import EmpiricalRTN, ForceModel
 from odpipe.measurements import MeasurementSetup, compute, residuals
+from odpipe.measurements.timetag import tag_rate
 
 from .segment import SegmentTrajectory, ShiftedSegmentTrajectory
 
-_LINEAR = ("bias", "station", "media")
+_LINEAR = ("bias", "station", "media", "timing")
 _REFERENCE = ("dynamic", "stochastic", "maneuver", "maneuver_epoch", "clock")
 _SUPPORTED = ("state",) + _LINEAR + _REFERENCE
 # a bias parameter's info key -> the row column it selects on
@@ -301,7 +304,8 @@ class TrackingProblem:
         H_lin = np.zeros((m, n))
         if m == 0:
             return np.zeros(0), np.zeros(0), np.zeros(0, object), G_x, G_p, H_lin
-        ev = compute(rows, trajs, self._measurement_setup(x0))
+        setup = self._measurement_setup(x0)
+        ev = compute(rows, trajs, setup)
         res, _ = residuals(rows, ev)
         observed = rows["value"].to_numpy(float)
         value = np.where(np.isfinite(observed), observed - res, ev.value)  # computed, wrapped to the observation
@@ -313,8 +317,12 @@ class TrackingProblem:
         if any(p.kind == "bias" for p in params):
             per_bias = (ev.partials["bias"][:, 0] if "bias" in ev.partials else np.ones(m)) \
                 / np.where(rows["unit"].to_numpy() == "rad", 1.0, ev.to_los)  # angles stay angles
+        rate = tag_rate(rows, trajs, setup, ev.value) if any(p.kind == "timing" for p in params) else None
         for i, p in enumerate(params):
-            if p.kind == "bias":
+            if p.kind == "timing":
+                sel = self._bias_rows(p, columns, m)
+                H_lin[sel, i] = -rate[sel]
+            elif p.kind == "bias":
                 sel = self._bias_rows(p, columns, m)
                 H_lin[sel, i] = per_bias[sel]
             elif p.kind == "station" and f"station:{p.owner}" in ev.partials:

@@ -158,6 +158,8 @@ class PreprocessSection:
     partial: Literal["keep", "flag", "drop"] = "keep"
     elevation_mask_deg: float = checked(between(-90.0, 90.0), default=10.0)  # deg, at the receiving station
     blunder_k: float = checked(positive, default=10.0)  # robust sigmas of a pass's detrended values: BLUNDER
+    # robust sigmas of a pass's a priori residuals, detrended the same way: BLUNDER (none: not tested)
+    apriori_blunder_k: float | None = checked(positive, default=None)
     min_pass_samples: int = checked(at_least(1), default=10)  # passes with fewer rows are flagged SHORT_PASS
 
 
@@ -349,6 +351,8 @@ class EstimationSection:
     polynomial_sigma: list[float] | None = checked(positive, default=None)
     # m/s, a per-pass two-way Doppler bias (none: not estimated; odpipe.analysis.station_diagnostics)
     doppler_bias_sigma: float | None = checked(positive, default=ArcSetup.doppler_bias_sigma)
+    # s, a time-tag offset per receiving station, tags late, relative to the station with the most rows (none: not estimated)
+    station_time_offset_sigma: float | None = checked(positive, default=ArcSetup.time_offset_sigma)
     # one-way Doppler's oscillator, estimated when set: sigmas of its fractional frequency offset y0 and drift
     # y1 (1/s) about the arc start, one pair for every band it drives (a priori 0: the rows' reference)
     oscillator_sigma: list[float] | None = checked(positive, default=None)

@@ -32,8 +32,10 @@ from odpipe.pipeline.config import RunConfig, load_config
 from odpipe.pipeline.geometry import add_geometry, apparent_itrs, median_round_trip
 from odpipe.pipeline.ingest import ingest
 from odpipe.pipeline.fitted_trajectory import fitted_segments
+from odpipe.preprocess.apriori_blunders import apriori_blunders
 from odpipe.preprocess.compress import compress
 from odpipe.preprocess.edit import EditConfig, edit
+from odpipe.preprocess.flags import Flag
 from odpipe.products import parameters, residuals
 from parsers.atomic import write_parquet, write_text
 from odpipe.products.oem import write_oem
@@ -139,6 +141,11 @@ def _run(cfg: RunConfig, attempt, log: RunLog, fingerprint: dict) -> dict:
                           arc=(np.datetime64(cfg.arc.start, "ns"), np.datetime64(cfg.arc.end, "ns")))
     table, edits = edit(table, data.ramps, edit_cfg)
     log("edit: " + ", ".join(f"{r} {n}" for r, n in zip(edits["reason"], edits["rows"]) if n))
+    if pre.apriori_blunder_k is not None:
+        bad = apriori_blunders(table, apriori, setup.measurements, cfg.arc.spacecraft, pre.apriori_blunder_k,
+                               table["flags"].to_numpy() == 0)
+        table.loc[bad, "flags"] = table.loc[bad, "flags"] | int(Flag.BLUNDER)
+        log(f"edit: blunders against the a priori orbit {int(bad.sum())}")
 
     t0 = time.perf_counter()
     arc = _fit(table, setup, log, shared)
@@ -212,7 +219,7 @@ def _products(cfg, attempt, log, table, arc, edits, fit_seconds, findings, finge
     write_text(attempt.product("residual_statistics.csv"), stats.to_csv(index=False))
     per_pass = residuals.statistics(res, by=("station_rx", "observable", "pass_id"))
     write_text(attempt.product("residual_statistics_passes.csv"), per_pass.to_csv(index=False))
-    diag = station_diagnostics.diagnose(station_diagnostics.rows_used(res, table, ramps))
+    diag = station_diagnostics.diagnose(station_diagnostics.rows_used(res, table, ramps), params=arc.parameters)
     write_text(attempt.product("station_diagnostics.csv"), diag.to_csv(index=False))
     params = parameters.with_units(arc.parameters)
     write_text(attempt.product("parameters.csv"), params.to_csv(index=False))

@@ -165,7 +165,7 @@ def arc_setup(cfg: RunConfig, fm: F.ForceModel, ramps, catalog: StationCatalog) 
                     polynomial_sigma=tuple(est.polynomial_sigma) if est.polynomial_sigma else None,
                     outward=None if est.outward is None else (t_state, est.outward.first_hours * 3600.0,
                                                                est.outward.factor),
-                    doppler_bias_sigma=est.doppler_bias_sigma,
+                    doppler_bias_sigma=est.doppler_bias_sigma, time_offset_sigma=est.station_time_offset_sigma,
                     oscillator_sigma=None if est.oscillator_sigma is None else tuple(est.oscillator_sigma),
                     edit_k=tuple(est.edit_k), max_iter=est.max_iter, reweight=est.reweight,
                     sigma_scale=tuple(est.sigma_scale), block=est.block,

@@ -27,7 +27,7 @@ _GROUPS = {
     "1": ("1", 1.0, "{:.5f}"),
 }
 _TITLES = {"m": "positions, station coordinates and range biases", "rad": "angle biases", "m/s": "velocities",
-           "dv": "maneuver ΔV components", "s": "maneuver epoch offsets", "m/s2": "stochastic and polynomial accelerations",
+           "dv": "maneuver ΔV components", "s": "maneuver epoch offsets and station time-tag offsets", "m/s2": "stochastic and polynomial accelerations",
            "m/s3": "polynomial acceleration drifts",
            "1/s": "frequency drifts", "1": "scale factors and fractional offsets"}
 
@@ -42,7 +42,7 @@ def group(name: str, kind: str) -> str:
         return "m"
     if kind == "maneuver":
         return "dv"
-    if kind == "maneuver_epoch":
+    if kind in ("maneuver_epoch", "timing"):
         return "s"
     if kind == "stochastic":
         return "m/s2"
