@@ -415,7 +415,7 @@ def run(cfg: dict, out, log=print, sim: dict | None = None) -> dict:
                                       ("3-D 3-sigma", m[sc]["sig3"], {"color": "k", "ls": ":"})]})
     df = pd.DataFrame(table)
     spread_sections, tau_summary, geo = [], None, None
-    if sens["acc_tau_s"]:
+    if sens["acc_tau_s"] and sens["cases"]:
         tau_rows, tau_summary = tau_spread(cfg, sim, log)
         spread_sections.append(("Correlation time of the empirical accelerations (not in the thesis): spread of "
                                 "odpipe/thesis", write_table(out, "tau_spread", tau_summary) + "\n"
