@@ -414,7 +414,7 @@ def run(cfg: dict, out, log=print, sim: dict | None = None) -> dict:
                            "curves": [("|truth - filtered|", m[sc]["err"], {"color": "k"}),
                                       ("3-D 3-sigma", m[sc]["sig3"], {"color": "k", "ls": ":"})]})
     df = pd.DataFrame(table)
-    spread_sections, tau_summary, geo = [], None, None
+    spread_sections, tau_rows, tau_summary, geo = [], None, None, None
     if sens["acc_tau_s"] and sens["cases"]:
         tau_rows, tau_summary = tau_spread(cfg, sim, log)
         spread_sections.append(("Correlation time of the empirical accelerations (not in the thesis): spread of "
@@ -440,5 +440,5 @@ def run(cfg: dict, out, log=print, sim: dict | None = None) -> dict:
                     ("Differences from the thesis", cfg["report"]["differences"] + "\n"),
                     ("Fits", notes + "\n\nTrue range biases (m): "
                      + ", ".join(f"{k} {v:.2f}" for k, v in rows.attrs["bias"].items()) + "\n")])
-    return {"table": df, "results": results, "x0": sim["x0"], "sim": sim, "tau_spread": tau_summary,
-            "geo_ground_only": geo}
+    return {"table": df, "results": results, "x0": sim["x0"], "sim": sim, "tau_cases": tau_rows,
+            "tau_spread": tau_summary, "geo_ground_only": geo}
