@@ -256,14 +256,15 @@ def test_whole_run_schedule_trade():
 @pytest.mark.realdata
 def test_whole_run_geo_ground_only_and_the_correlation_time():
     """Why GEO's uncertainty shrinks from Sky Valley alone, one filter choice changed at a time (recorded): with
-    Table 8.3's a priori (1 km, 1 mm/s) 351 m, 15x below the a priori; with a 0.1-m/s a priori velocity 2,189 m
-    (2.4x; the normal axis keeps 2,130 of its 3,000 m): the 1-mm/s velocity a priori, carried through the
+    Table 8.3's a priori (1 km, 1 mm/s) 351 m, 15x below the a priori; with a 1-cm/s a priori velocity 1,327 m
+    (3.9x), with 0.1 m/s 2,189 m (2.4x; the normal axis keeps 2,130 of its 3,000 m): the 1-mm/s velocity a priori, carried through the
     dynamics, is what makes the ground-only fit shrink it. The correlation time does not matter for GEO (3 h:
     351 m) but does for the halo: ground only, 3 h gives 30.8 m (0.44x the thesis' 70 m, outside the factor 2),
     1 day 35.8 m (0.51x)."""
     res = run_study("study_ground_and_crosslink")
     geo = res["geo_ground_only"].set_index("filter")["GEO 3s RMS d6-9"]
     assert geo["Table 8.3 (1 km, 1 mm/s, tau 1 d)"] == as_recorded("351")
+    assert geo["a priori velocity 0.01 m/s"] == as_recorded("1327")
     assert geo["a priori velocity 0.1 m/s"] == as_recorded("2189")
     assert geo["tau 3 h"] == as_recorded("351")
     tau = res["tau_cases"]

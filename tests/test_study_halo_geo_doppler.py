@@ -57,7 +57,9 @@ def test_simulated_doppler_equals_the_fit_reference():
 # odpipe's Tables 4-6 for the shipped configuration (3-D RMS over the last half of the arc; seeded run):
 # (case, estimator, spacecraft, quantity) -> figure as recorded in docs/validation.md
 RECORDED = {("S", "filter_smoother", "L1", "Pos"): "165", ("S", "filter_smoother", "GEO", "Pos"): "25.0",
-            ("X", "filter_smoother", "L1", "Pos"): "82", ("X", "filter_smoother", "GEO", "Pos"): "10.6"}
+            ("X", "filter_smoother", "L1", "Pos"): "82", ("X", "filter_smoother", "GEO", "Pos"): "10.6",
+            ("X", "ekf", "L1", "Pos"): "82.1", ("X", "ekf", "GEO", "Pos"): "10.6",
+            ("X", "ekf", "L1", "Vel"): "0.00144", ("X", "ekf", "GEO", "Vel"): "0.00078"}
 
 
 def _table():
@@ -85,3 +87,16 @@ def test_whole_run_tables45_disagree_with_the_paper_as_recorded():
             assert rows[(band, "filter_smoother", sc, "Pos")]["odpipe/paper 3D"] < 0.6
         assert rows[(band, "filter_smoother", "GEO", "Pos")]["odpipe 3D"] < rows[(band, "filter_smoother", "L1", "Pos")]["odpipe 3D"]
     assert rows[("X", "filter_smoother", "L1", "Pos")]["odpipe 3D"] < 0.6 * rows[("S", "filter_smoother", "L1", "Pos")]["odpipe 3D"]
+
+
+@whole_run
+def test_whole_run_the_paper_s_ekf_is_not_the_cause():
+    """The paper's estimator, one EKF pass with the same SNC, gives odpipe's filter-smoother's X-band positions to
+    within 2 % (L1 82.1 against 82 m, GEO 10.6 against 10.6 m): the 1.8-7.5x gap to Tables 4-5 does not come from
+    iterating and smoothing. Tolerance 5 %: both are forward filters of the same model and data; only the
+    linearization differs. The EKF's halo velocity is 0.65x the paper's (1.44 against 2.19 mm/s)."""
+    rows = _table()
+    for sc in ("L1", "GEO"):
+        ekf, fs = rows[("X", "ekf", sc, "Pos")]["odpipe 3D"], rows[("X", "filter_smoother", sc, "Pos")]["odpipe 3D"]
+        assert ekf == pytest.approx(fs, rel=0.05), sc
+        assert rows[("X", "ekf", sc, "Pos")]["odpipe/paper 3D"] < 0.3
