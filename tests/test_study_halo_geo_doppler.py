@@ -62,7 +62,9 @@ RECORDED = {("S", "filter_smoother", "L1", "Pos"): "165", ("S", "filter_smoother
             ("S", "ekf", "L1", "Vel"): "0.00378", ("S", "ekf", "GEO", "Vel"): "0.00180",
             ("X", "ekf", "L1", "Pos"): "82.1", ("X", "ekf", "GEO", "Pos"): "10.6",
             ("X", "ekf", "L1", "Vel"): "0.00144", ("X", "ekf", "GEO", "Vel"): "0.00078",
-            ("S_L1_known", "ekf", "GEO", "Pos"): "23.6", ("S_L1_known", "ekf", "GEO", "Vel"): "0.00170"}
+            ("S_L1_known", "ekf", "GEO", "Pos"): "23.6", ("S_L1_known", "ekf", "GEO", "Vel"): "0.00170",
+            ("X", "ekf_gap_snc", "L1", "Pos"): "223", ("X", "ekf_gap_snc", "GEO", "Pos"): "31.7",
+            ("X", "ekf_gap_snc", "L1", "Vel"): "0.00264", ("X", "ekf_gap_snc", "GEO", "Vel"): "0.00229"}
 
 
 def _table():
@@ -119,3 +121,18 @@ def test_whole_run_table6_halo_known_is_no_better_as_in_the_paper():
     assert 0.8 < known["odpipe 3D"] / both["odpipe 3D"] < 1.2
     assert known["paper 3D"] / both["paper 3D"] == pytest.approx(1.056, abs=1e-3)
     assert known["odpipe/paper 3D"] < 0.4
+
+
+@whole_run
+def test_whole_run_snc_over_the_data_gaps_moves_toward_the_paper():
+    """Eqs. 10-11 taken literally (Gamma Q Gamma^T over the time since the previous point, so the GEO cut-off's
+    gaps of about 13 intervals get 13^2 times one interval's velocity variance instead of 13 times): X band L1
+    223 m and GEO 31.7 m, 2.7-3.0x the per-interval EKF's and 0.75x / 0.40x the paper's (velocities 1.20x /
+    0.40x). The L1 halo lands within the factor 2 the other studies allow; GEO does not. A candidate cause of the
+    gap to Table 5, measured on the X band only (the S band was not run this session)."""
+    rows = _table()
+    for sc in ("L1", "GEO"):
+        gap, ekf = (rows[("X", est, sc, "Pos")]["odpipe 3D"] for est in ("ekf_gap_snc", "ekf"))
+        assert gap > 2.5 * ekf, sc
+    assert 0.5 < rows[("X", "ekf_gap_snc", "L1", "Pos")]["odpipe/paper 3D"] < 2.0
+    assert rows[("X", "ekf_gap_snc", "GEO", "Pos")]["odpipe/paper 3D"] < 0.5
