@@ -20,7 +20,8 @@ from odpipe.studies.crosslink_pair import CrosslinkPair
 from odpipe.studies.crtbp_orbits import halo_by_period, keplerian_orbit
 from odpipe.studies.crtbp_problem import RANGE, RANGE_RATE
 from odpipe.studies.formation_observability import (formations, halo_start_sensitivity, log_ratios,
-                                                    observability_row, orbits, units)
+                                                    lunar_phase_rows, lunar_phase_sensitivity, observability_row,
+                                                    orbits, units)
 from odpipe.studies.scenarios import load_config
 
 CFG = load_config(Path(__file__).parents[1] / "runs" / "study_formation_observability.toml")
@@ -40,6 +41,12 @@ TABLE1 = {
 }
 # mean deviation factor from the paper over the EML1/L2 columns for each start of the two halos
 HALO_START_MEAN_FACTOR = [1.2627, 5.5729, 7.4986, 19.948, 2.8500, 26.493, 10.810, 426.83]
+# odpipe/paper over the 16 EML1/L2 measures pooled over the 8 starts: min, median, max
+HALO_START_SPREAD = [0.0041004, 1.6360, 11088.4]
+# the lunar columns over the orbiter's 8 start phases (0, 45, ..., 315 deg): mean factor per phase, and
+# odpipe/paper over the 32 measures pooled over the phases: min, median, max
+LUNAR_PHASE_MEAN_FACTOR = [1.9277, 1.9063, 4.6999, 19.137, 25.391, 15.587, 4.5029, 1.6002]
+LUNAR_PHASE_SPREAD = [0.00095400, 0.36180, 4.6038]
 
 
 @pytest.fixture(scope="module")
@@ -99,11 +106,35 @@ def test_table1_lunar_columns_differ_from_the_paper_as_recorded(table1):
 
 def test_halo_start_snapshot(table1):
     """The report's halo_start table: odpipe's mean factor from the paper for each of the eight starts of the
-    two halos (the paper gives none), relative 1e-3; the shipped start is the first and the best."""
+    two halos (the paper gives none) and the spread of odpipe/paper over all of them, relative 1e-3; the
+    shipped start is the first and the best."""
     U, orb, cols, _ = table1
     table = halo_start_sensitivity(CFG, U, cols, orb)
-    np.testing.assert_allclose(table["mean factor"], HALO_START_MEAN_FACTOR, rtol=1e-3)
-    assert table["mean factor"].idxmin() == 0
+    np.testing.assert_allclose(table["mean factor"][:8], HALO_START_MEAN_FACTOR, rtol=1e-3)
+    assert table["mean factor"][:8].idxmin() == 0
+    pooled = table.iloc[8]
+    np.testing.assert_allclose(pooled[["ratio min", "ratio median", "ratio max"]].to_numpy(float), HALO_START_SPREAD,
+                               rtol=1e-3)
+    # Over the 8 starts, odpipe/paper on the 16 EML1/L2 measures spans 0.0041-11,088 (median 1.64): Table 1 is
+    # sensitive to the start, and only the shipped start (the best) is within 2.5x. The median is within 2x of the
+    # paper, the ends are not: the close agreement is the start's, not the set-up's alone.
+    assert 0.5 < pooled["ratio median"] < 2.0
+    assert pooled["ratio min"] < 0.01 and pooled["ratio max"] > 1000
+    assert (table["worst factor"][:8] < 2.5).sum() == 1
+
+
+def test_lunar_columns_spread_over_the_orbiter_start_phase(table1):
+    """The lunar columns over the orbiter's start phase (the paper gives the period only): mean factor 1.6-25 by
+    phase (snapshot, relative 1e-3), odpipe/paper pooled over the phases 0.00095-4.6 with median 0.36. The
+    configured start (periselene) is within 2x of the paper on average, as are 45 and 315 deg; the figures move
+    up to 1000x with the phase: sensitive."""
+    U, orb, cols, _ = table1
+    table = lunar_phase_sensitivity(CFG, lunar_phase_rows(CFG, U, cols, orb))
+    np.testing.assert_allclose(table["mean factor"][:8], LUNAR_PHASE_MEAN_FACTOR, rtol=1e-3)
+    pooled = table.iloc[8]
+    np.testing.assert_allclose(pooled[["ratio min", "ratio median", "ratio max"]].to_numpy(float), LUNAR_PHASE_SPREAD,
+                               rtol=1e-3)
+    assert list(table["mean factor"][:8] < 2.0) == [True, True, False, False, False, False, False, True]
 
 
 @pytest.fixture(scope="module")

@@ -9,7 +9,8 @@ Scenarios (the module name says what is studied; the paper in brackets):
 * :mod:`.halo_geo_crtbp` - an L1 halo and a GEO satellite tracked only by each other, CRTBP
   range and range-rate (Fujimoto et al. 2012, sec. 2.1);
 * :mod:`.halo_geo_doppler` - the same pair with two-way crosslink Doppler and high-fidelity
-  dynamics, S and X band (Fujimoto et al. 2012, secs. 3-4, Tables 4-5);
+  dynamics, S and X band, and the S band with the halo's state known (Fujimoto et al. 2012, secs. 3-4,
+  Tables 4-6);
 * :mod:`.formation_observability` - range-only against range-rate-only crosslinks for halo/halo and
   halo/lunar-orbiter formations: Gramian measures, Monte Carlo, CRLB (Turan et al. 2022, Table 1);
 * :mod:`.dro_leo_dowr` - DRO-LEO dual one-way ranging with clocks (Li et al. 2023, Table 13);
@@ -22,6 +23,7 @@ Scenarios (the module name says what is studied; the paper in brackets):
 
 Building blocks: :mod:`.crtbp_orbits` (halos by period, Keplerian orbiters), :mod:`.crtbp_problem`
 (the two-spacecraft CRTBP crosslink problem for the fit), :mod:`.crosslink_pair` (one experiment:
-simulation, Monte Carlo trial, CRLB, Gramian), :mod:`.study_report` (tables and plots),
+simulation, Monte Carlo trial, CRLB, Gramian), :mod:`.ekf` (the single-pass EKF the Fujimoto paper used,
+beside odpipe's filter-smoother), :mod:`.study_report` (tables, plots, spreads over open choices),
 :mod:`.scenarios` (the configuration kinds, loaded strictly).
 """

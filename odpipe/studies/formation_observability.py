@@ -28,7 +28,7 @@ from odpipe.dynamics.crtbp import jacobi_constant
 from .crtbp_problem import RANGE, RANGE_RATE, units_from_mu
 from .crtbp_orbits import halo_by_period, halo_start, keplerian_orbit
 from .crosslink_pair import CrosslinkPair
-from .study_report import plot_convergence, write_markdown, write_table
+from .study_report import plot_convergence, spread, write_markdown, write_table
 
 DAY = SECONDS_PER_DAY
 TYPES = {"range": (RANGE,), "range-rate": (RANGE_RATE,)}
@@ -89,23 +89,23 @@ def observability_row(pair: CrosslinkPair) -> dict:
     return out
 
 
-def lunar_phase_band(cfg, U, cols, orb) -> dict:
-    """{column: {quantity: (min, max)}} of the lunar formations' Table 1 quantities over the
-    orbiter's starting true anomaly (the paper does not give it)."""
-    lo = cfg["lunar"]
-    period = orb["lunar"][1]
+def lunar_phase_rows(cfg, U, cols, orb) -> dict:
+    """{start true anomaly (deg): {column: Table 1 row}} of the lunar formations over the orbiter's
+    starting true anomaly ``lunar.phase_band_deg`` (the paper does not give it)."""
     out = {}
-    for j, (label, pair) in enumerate(cols):
-        if "Lunar" not in label:
-            continue
-        vals = []
-        for nu in lo["phase_band_deg"]:
-            x = keplerian_orbit(period, lo["ecc"], np.radians(lo["inc_deg"]), U.mu,
-                              np.radians(lo.get("raan_deg", 0.0)), np.radians(lo.get("argp_deg", 0.0)),
-                              np.radians(nu))
-            vals.append(observability_row(replace(pair, x2=U.to_si(x))))
-        out[j] = {k: (min(v[k] for v in vals), max(v[k] for v in vals)) for k in vals[0]}
+    for nu in cfg["lunar"]["phase_band_deg"]:
+        x = U.to_si(_lunar_orbiter(cfg, U, orb["lunar"][1], nu))
+        out[nu] = {j: observability_row(replace(pair, x2=x)) for j, (label, pair) in enumerate(cols) if "Lunar" in label}
     return out
+
+
+def lunar_phase_band(phase_rows: dict) -> dict:
+    """{column: {quantity: (min, max)}} over the start phases of :func:`lunar_phase_rows`."""
+    by_col = {}
+    for rows in phase_rows.values():
+        for j, r in rows.items():
+            by_col.setdefault(j, []).append(r)
+    return {j: {k: (min(v[k] for v in vals), max(v[k] for v in vals)) for k in vals[0]} for j, vals in by_col.items()}
 
 
 QUANTITIES = (("Xi_mean", "xi_mean"), ("cond range", "cond_range"), ("cond range-rate", "cond_range_rate"),
@@ -120,7 +120,8 @@ def log_ratios(row: dict, paper: dict, j: int) -> np.ndarray:
 def halo_start_sensitivity(cfg, U, cols, orb) -> pd.DataFrame:
     """EML1/L2 Gramian measures against the paper for each start of the two halos (apolune or
     perilune crossing, L2 north or south of the plane with L1 north): the geometric mean and the
-    largest factor between odpipe and the paper (10^|log10 ratio|)."""
+    largest factor between odpipe and the paper (10^|log10 ratio|), and the spread of odpipe/paper
+    over the 16 measures; a last row "all starts" pools the 8 x 16 ratios."""
     paper, rows = cfg["paper"]["table1"], []
     for at1 in ("apolune", "perilune"):
         for at2 in ("apolune", "perilune"):
@@ -133,10 +134,34 @@ def halo_start_sensitivity(cfg, U, cols, orb) -> pd.DataFrame:
                     x1, x2 = halo_start(s1, T1, U.mu, at1, True), halo_start(s2, T2, U.mu, at2, north2)
                     L.append(log_ratios(observability_row(replace(pair, x1=U.to_si(x1), x2=U.to_si(x2))),
                                         paper, j))
-                L = np.abs(np.array(L))
-                rows.append({"L1 start": f"{at1}, north", "L2 start": f"{at2}, {'north' if north2 else 'south'}",
-                             "mean factor": 10 ** L.mean(), "worst factor": 10 ** L.max()})
-    return pd.DataFrame(rows)
+                rows.append(_factors(np.array(L), {"L1 start": f"{at1}, north",
+                                                   "L2 start": f"{at2}, {'north' if north2 else 'south'}"}))
+    pooled = np.concatenate([r.pop("log ratios") for r in rows])
+    return pd.DataFrame(rows + [{k: v for k, v in _factors(pooled, {"L1 start": "all starts", "L2 start": ""}).items()
+                                 if k != "log ratios"}])
+
+
+def _factors(L: np.ndarray, labels: dict) -> dict:
+    """A choice's row: geometric-mean and worst factor from log10(odpipe/paper) ``L``, and the ratios' spread."""
+    return {**labels, "mean factor": 10 ** np.abs(L).mean(), "worst factor": 10 ** np.abs(L).max(),
+            **spread(10 ** L), "log ratios": L.ravel()}
+
+
+def lunar_phase_sensitivity(cfg, phase_rows: dict) -> pd.DataFrame:
+    """The lunar columns' Gramian measures against the paper for each start phase of :func:`lunar_phase_rows`:
+    factors and spread over the 32 measures, and a last row pooling every phase."""
+    rows = [_factors(np.array([log_ratios(r, cfg["paper"]["table1"], j) for j, r in cols.items()]),
+                     {"start true anomaly deg": nu}) for nu, cols in phase_rows.items()]
+    pooled = np.concatenate([r.pop("log ratios") for r in rows])
+    return pd.DataFrame(rows + [{k: v for k, v in _factors(pooled, {"start true anomaly deg": "all"}).items()
+                                 if k != "log ratios"}])
+
+
+def _lunar_orbiter(cfg, U, period, nu_deg) -> np.ndarray:
+    """The configured lunar orbiter (CRTBP units) started at true anomaly ``nu_deg``."""
+    lo = cfg["lunar"]
+    return keplerian_orbit(period, lo["ecc"], np.radians(lo["inc_deg"]), U.mu, np.radians(lo.get("raan_deg", 0.0)),
+                           np.radians(lo.get("argp_deg", 0.0)), np.radians(nu_deg))
 
 
 def montecarlo_curves(pair: CrosslinkPair, n_runs: int, seed: int, parallel: bool, workers=None):
@@ -172,7 +197,8 @@ def run(cfg: dict, out, log=print) -> dict:
         log(f"{label}: Xi_mean {r['Xi_mean']:.1f}, cond {r['cond range']:.2e}/{r['cond range-rate']:.2e}, "
             f"1/min eig {r['1/min eig range']:.3g}/{r['1/min eig range-rate']:.3g}")
     obs = pd.DataFrame(rows)
-    band = lunar_phase_band(cfg, U, cols, orb)
+    phase_rows = lunar_phase_rows(cfg, U, cols, orb)
+    band = lunar_phase_band(phase_rows)
     side = []
     for key, pkey in QUANTITIES:
         for j, (label, _) in enumerate(cols):
@@ -193,6 +219,9 @@ def run(cfg: dict, out, log=print) -> dict:
     sections.append(("EML1/L2 Table 1 against the halos' start (the paper gives neither phase nor hemisphere; "
                      "deviation factors over the 4 columns x 4 Gramian measures)",
                      write_table(out, "halo_start", halo_start_sensitivity(cfg, U, cols, orb))))
+    sections.append(("Lunar columns of Table 1 against the orbiter's start phase (the paper gives the period only; "
+                     "factors and odpipe/paper spread over the 8 columns x 4 Gramian measures)",
+                     write_table(out, "lunar_phase", lunar_phase_sensitivity(cfg, phase_rows))))
 
     # Monte Carlo and CRLB on the selected formations
     mc = cfg["montecarlo"]

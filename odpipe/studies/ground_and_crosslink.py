@@ -50,7 +50,7 @@ from odpipe.time import utc_to_tdb
 from parsers.table import build
 
 from .halo_geo_doppler import link_clear
-from .study_report import plot_convergence, write_markdown, write_table
+from .study_report import plot_convergence, spread, write_markdown, write_table
 
 DAY = SECONDS_PER_DAY
 NAMES = ("L1", "GEO")
@@ -279,6 +279,78 @@ def table_rows(name: str, case: dict, m: dict, paper: dict) -> list[dict]:
     return out
 
 
+FIGURES = ("3s RMS d6-9", "final 3s", "day 3s<100 m")
+
+
+def tau_spread(cfg, sim: dict, log=print) -> tuple[pd.DataFrame, pd.DataFrame]:
+    """The ``sensitivity.cases`` refitted with each correlation time ``sensitivity.acc_tau_s`` (the thesis
+    gives none): every thesis figure with odpipe's beside it per correlation time, and per figure the
+    spread of odpipe/thesis over them (with the correlation times of its ends)."""
+    sens, rows = cfg["sensitivity"], []
+    for tau in sens["acc_tau_s"]:
+        cfg_tau = dict(cfg, filter=dict(cfg["filter"], acc_tau_s=tau))
+        for name in sens["cases"]:
+            case = cfg["cases"][name]
+            m = fit_schedule(cfg, sim, case, cfg_tau)["metrics"]
+            log(f"{name}, correlation time {tau / 3600:g} h: "
+                + ", ".join(f"{sc} 3-sigma {m[sc]['rms_sig3']:.1f} m" for sc in NAMES))
+            for r in table_rows(name, case, m, cfg["paper"].get(name, {})):
+                rows += [{"case": name, "spacecraft": r["spacecraft"], "figure": fig, "tau h": tau / 3600.0,
+                          "thesis": r[f"thesis {fig}"], "odpipe": r[f"odpipe {fig}"],
+                          "odpipe/thesis": r[f"odpipe {fig}"] / r[f"thesis {fig}"]}
+                         for fig in FIGURES if np.isfinite(r[f"thesis {fig}"])]
+    df = pd.DataFrame(rows)
+    summary = []
+    for (name, sc, fig), g in df.groupby(["case", "spacecraft", "figure"], sort=False):
+        ratio = g["odpipe/thesis"].to_numpy()
+        summary.append({"case": name, "spacecraft": sc, "figure": fig, "thesis": g["thesis"].iloc[0], **spread(ratio),
+                        "tau h at min": g["tau h"].iloc[int(np.argmin(ratio))],
+                        "tau h at max": g["tau h"].iloc[int(np.argmax(ratio))]})
+    return df, pd.DataFrame(summary)
+
+
+def rtn_sig3(sol, truth, sc: str, t0: float, window_days) -> np.ndarray:
+    """RMS over the window of the filter's position 3-sigma (m) along the truth's radial, transverse and
+    normal axes of spacecraft ``sc``."""
+    i = NAMES.index(sc)
+    grid = sol.grid
+    win = (grid >= t0 + window_days[0] * DAY) & (grid <= t0 + window_days[1] * DAY)
+    x = truth[sc].state(grid[win])
+    r = x[:, :3] / np.linalg.norm(x[:, :3], axis=1)[:, None]
+    n = np.cross(x[:, :3], x[:, 3:])
+    n /= np.linalg.norm(n, axis=1)[:, None]
+    A = np.stack([r, np.cross(n, r), n], axis=1)                    # rows R, T, N
+    P = sol.filtered_P[win][:, 6 * i:6 * i + 3, 6 * i:6 * i + 3]
+    var = np.einsum("kij,kjl,kil->ki", A, P, A)
+    return 3.0 * np.sqrt(np.mean(var, axis=0))
+
+
+def geo_ground_only(cfg, sim: dict, log=print) -> pd.DataFrame:
+    """Why the GEO satellite's uncertainty shrinks from Sky Valley tracking alone (the thesis: it is not
+    reduced): the "ground" case with Table 8.3's filter and with one choice changed at a time (a priori
+    velocity ``sensitivity.geo_apriori_vel_mps``, correlation time ``sensitivity.acc_tau_s``, accelerations
+    x ``acc_scale``); the GEO 3-D 3-sigma RMS over the window, its reduction from the a priori and its
+    R/T/N parts."""
+    f, sens, case = cfg["filter"], cfg["sensitivity"], cfg["cases"]["ground"]
+    variants = [("Table 8.3 (1 km, 1 mm/s, tau 1 d)", f)]
+    variants += [(f"a priori velocity {v:g} m/s", dict(f, apriori_vel_mps=v)) for v in sens["geo_apriori_vel_mps"]]
+    variants += [(f"tau {t / 3600:g} h", dict(f, acc_tau_s=t)) for t in sens["acc_tau_s"] if t != f["acc_tau_s"]]
+    variants.append((f"accelerations x{sens['acc_scale']:g}",
+                     dict(f, acc_sigma_rtn=[sens["acc_scale"] * a for a in f["acc_sigma_rtn"]])))
+    rows = []
+    for label, filt in variants:
+        res = fit_schedule(cfg, sim, case, dict(cfg, filter=filt))
+        m = res["metrics"]["GEO"]
+        apriori = 3.0 * np.sqrt(3.0) * filt["apriori_pos_m"]
+        rtn = rtn_sig3(res["solution"], sim["truth"], "GEO", sim["t0"], cfg["window_days"])
+        log(f"GEO from the ground alone, {label}: 3-sigma {m['rms_sig3']:.0f} m, {apriori / m['rms_sig3']:.1f}x "
+            f"below the a priori")
+        rows.append({"filter": label, "GEO 3s RMS d6-9": m["rms_sig3"], "a priori 3-D 3s": apriori,
+                     "reduction": apriori / m["rms_sig3"], "R 3s": rtn[0], "T 3s": rtn[1], "N 3s": rtn[2],
+                     "error RMS d6-9": m["rms_err"]})
+    return pd.DataFrame(rows)
+
+
 def observed_biases(cfg, rows: pd.DataFrame) -> list[str]:
     """Names of the range biases that some of ``rows`` depend on."""
     return [name for name, _, info in bias_parameters(cfg)
@@ -342,6 +414,16 @@ def run(cfg: dict, out, log=print, sim: dict | None = None) -> dict:
                            "curves": [("|truth - filtered|", m[sc]["err"], {"color": "k"}),
                                       ("3-D 3-sigma", m[sc]["sig3"], {"color": "k", "ls": ":"})]})
     df = pd.DataFrame(table)
+    spread_sections, tau_rows, tau_summary, geo = [], None, None, None
+    if sens["acc_tau_s"] and sens["cases"]:
+        tau_rows, tau_summary = tau_spread(cfg, sim, log)
+        spread_sections.append(("Correlation time of the empirical accelerations (not in the thesis): spread of "
+                                "odpipe/thesis", write_table(out, "tau_spread", tau_summary) + "\n"
+                                + write_table(out, "tau_cases", tau_rows)))
+    if sens["geo_apriori_vel_mps"] and "ground" in cfg["cases"]:
+        geo = geo_ground_only(cfg, sim, log)
+        spread_sections.append(("GEO from Sky Valley alone: what reduces its uncertainty (thesis: not reduced)",
+                                write_table(out, "geo_ground_only", geo)))
     plot_convergence(out, "uncertainty", [{"title": f"{sc}: 3-D position 3-sigma of the filter (cf. Fig. 8.5)",
                                            "t_days": None, "curves": sigmas[sc]} for sc in NAMES], "m")
     plot_convergence(out, "position", panels, "m")
@@ -354,7 +436,9 @@ def run(cfg: dict, out, log=print, sim: dict | None = None) -> dict:
                         "(Leonard thesis sec. 8.1)",
                    [("Position uncertainty and error, thesis vs odpipe",
                      write_table(out, "cases", df) + "\n![uncertainty](uncertainty.png)\n\n![position](position.png)\n"),
+                    *spread_sections,
                     ("Differences from the thesis", cfg["report"]["differences"] + "\n"),
                     ("Fits", notes + "\n\nTrue range biases (m): "
                      + ", ".join(f"{k} {v:.2f}" for k, v in rows.attrs["bias"].items()) + "\n")])
-    return {"table": df, "results": results, "x0": sim["x0"], "sim": sim}
+    return {"table": df, "results": results, "x0": sim["x0"], "sim": sim, "tau_cases": tau_rows,
+            "tau_spread": tau_summary, "geo_ground_only": geo}

@@ -302,6 +302,8 @@ class DopplerFilter(DopplerTruth):
     max_iter: int = checked(positive)  # iterations per fit stage at most
     stage_days: list[float] = field(default_factory=list)  # d, growing arcs fitted first
     geo_cutoff_vx_mps: float = 0.0  # m/s, no data while the GEO satellite's |v_x| is below this
+    known_pos_m: float = 1e-3  # m, a priori sigma per axis of a spacecraft whose state is known (Table 6: "0")
+    known_vel_mps: float = 1e-6  # m/s, the same for velocity
 
 
 @section
@@ -314,10 +316,10 @@ class DopplerBand:
 
 @section
 class DopplerPaper:
-    """``[paper.NAME]`` (a band): the paper's Table 4/5 rows, x, y, z, 3-D RMS."""
+    """``[paper.NAME]`` (a band, or ``<band>_L1_known``): the paper's Table 4/5/6 rows, x, y, z, 3-D RMS."""
 
-    L1_pos: list[float]  # m
-    L1_vel: list[float]  # m/s
+    L1_pos: list[float] | None = None  # m (Table 6 has none)
+    L1_vel: list[float] | None = None  # m/s
     GEO_pos: list[float]  # m
     GEO_vel: list[float]  # m/s
     postfit_rms_mps: float | None = None  # m/s, the paper's post-fit residual RMS
@@ -334,13 +336,18 @@ class HaloGeoDoppler(Scenario):
     count_time_s: float = checked(positive)  # s, Doppler count time
     seed: int  # noise draws
     bands: list[str]  # the [band.X] tables to run, in order
+    # run on every case (the first one plotted): odpipe's iterated filter-smoother, the paper's single EKF
+    # pass with SNC per data interval, or with eqs. 10-11 over each gap between data
+    estimators: list[Literal["filter_smoother", "ekf", "ekf_gap_snc"]] = field(
+        default_factory=lambda: ["filter_smoother"])
+    known_bands: list[str] = field(default_factory=list)  # bands also run with the L1 state known (Table 6)
     gravity_file: Path = _gravity_file()  # Earth field (truth and filter)
     state: dict[str, list[float]]  # m, m/s: Earth-centred ICRF initial state by spacecraft (L1, GEO)
     deviation: dict[str, list[float]]  # m, m/s: initial deviation of the a priori by spacecraft
     truth: DopplerTruth
     filter: DopplerFilter
     band: dict[str, DopplerBand]  # by band name
-    paper: dict[str, DopplerPaper]  # by band name
+    paper: dict[str, DopplerPaper]  # by case: band name, or <band>_L1_known
 
 
 # --- dro_leo_dowr: Li et al. --------------------------------------------------------------------------------
@@ -574,10 +581,12 @@ class ReportText:
 
 @section
 class Sensitivity:
-    """Cases refitted with the filter's accelerations scaled."""
+    """Cases refitted with the filter's accelerations scaled, and over the choices the thesis leaves open."""
 
     acc_scale: float = checked(positive)  # factor on acc_sigma_rtn
     cases: list[str] = field(default_factory=list)  # the [cases.X] names refitted
+    acc_tau_s: list[float] = checked(positive, default_factory=list)  # s, correlation times these cases are refitted with
+    geo_apriori_vel_mps: list[float] = checked(positive, default_factory=list)  # m/s, "ground" refitted with these
 
 
 @section

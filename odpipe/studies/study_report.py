@@ -13,6 +13,12 @@ import pandas as pd
 from parsers.atomic import save_figure, write_csv, write_text
 
 
+def spread(ratios) -> dict:
+    """The spread of odpipe/paper ratios over the choices a paper leaves open: min, median, max."""
+    r = np.asarray(ratios, float).ravel()
+    return {"ratio min": float(r.min()), "ratio median": float(np.median(r)), "ratio max": float(r.max())}
+
+
 def _cell(v) -> str:
     if isinstance(v, (float, np.floating)):
         if not np.isfinite(v):
