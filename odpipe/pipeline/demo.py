@@ -41,6 +41,7 @@ from parsers import oem
 from parsers.maneuvers import read_plan
 
 CASE = Path(__file__).resolve().parents[2] / "runs" / "artemis_p2_like.toml"
+TWIN = CASE.with_name("artemis_p2_twin.toml")   # the ARTEMIS error budget (issue #25); slower
 HOUR = 3600.0
 OFFSET = np.array([1000.0, -800.0, 600.0, 0.01, -0.01, 0.005])  # a priori displacement, m and m/s
 

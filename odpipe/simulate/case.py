@@ -108,6 +108,7 @@ class Maneuver:
     epoch: str = checked(utc_time)  # UTC ISO time
     kind: str  # e.g. "attitude"
     dv: list[float] = checked(lambda v: _vector(v) + finite(v))  # designed delta-v, ICRF m/s
+    planned_dv: bool = False  # the maneuver plan carries its delta-v (false: its time only, delta-v 0)
 
 
 @dataclass(frozen=True)
@@ -184,7 +185,7 @@ class CaseFile:
 @dataclass(frozen=True)
 class Case:
     """A loaded case: the file's sections, times as UTC datetime64[ns], maneuvers in time order as dicts
-    (name, epoch, kind, dv: ICRF m/s array)."""
+    (name, epoch, kind, dv: ICRF m/s array, planned: whether the plan carries the delta-v)."""
 
     name: str
     seed: int
@@ -228,7 +229,8 @@ def load(path) -> Case:
     path = Path(path)
     data, text = read_toml(path)
     f = load_schema(CaseFile, data, path, text=text)
-    mans = [{"name": m.name, "epoch": _utc(m.epoch), "kind": m.kind, "dv": np.asarray(m.dv, float)}
+    mans = [{"name": m.name, "epoch": _utc(m.epoch), "kind": m.kind, "dv": np.asarray(m.dv, float),
+             "planned": m.planned_dv}
             for m in f.maneuver]
     return Case(f.name, f.seed, _utc(f.start), f.days, f.spacecraft, f.naif_id, f.orbit, f.spacecraft_model,
                 f.stochastic, sorted(mans, key=lambda m: m["epoch"]), f.execution, f.media, f.station_keeping,

@@ -78,10 +78,10 @@ def initial_state(case, ephemeris, t0: float) -> np.ndarray:
     return rotating_to_icrf(s, mu, ephemeris.state("moon", "earth", np.array([t0]))[0])
 
 
-def tilted(axis: np.ndarray, degrees: float, rng) -> np.ndarray:
-    """Unit ``axis`` turned by ``degrees`` about a random direction normal to it."""
+def tilted(axis: np.ndarray, degrees: float, w: np.ndarray) -> np.ndarray:
+    """Unit ``axis`` turned by ``degrees`` about the direction normal to it nearest ``w`` (3,)."""
     u = axis / np.linalg.norm(axis)
-    n = np.cross(u, rng.standard_normal(3))
+    n = np.cross(u, w)
     n /= np.linalg.norm(n)
     a = np.radians(degrees)
     return u * np.cos(a) + np.cross(n, u) * np.sin(a)
@@ -93,10 +93,10 @@ def model_body(sc) -> list:
     return [Cylinder(axis / np.linalg.norm(axis), sc.radius_m, sc.length_m, sc.rho_s, sc.rho_d)]
 
 
-def real_body(sc, tb, rng) -> tuple[list, np.ndarray]:
+def real_body(sc, tb, w: np.ndarray) -> tuple[list, np.ndarray]:
     """(SRP surfaces, spin axis) of the real body: the square bus spin-averaged as a cylinder of width
-    4/pi its side, one-sided plates at both ends, the axis tilted by ``tb.axis_tilt_deg``."""
-    axis = tilted(np.asarray(sc.spin_axis, float), tb.axis_tilt_deg, rng)
+    4/pi its side, one-sided plates at both ends, the axis tilted by ``tb.axis_tilt_deg`` (direction from ``w``)."""
+    axis = tilted(np.asarray(sc.spin_axis, float), tb.axis_tilt_deg, w)
     radius = 2.0 * tb.bus_side_m / np.pi
     surfaces = [Cylinder(axis, radius, sc.length_m, sc.rho_s, sc.rho_d)]
     if tb.plate_area_m2 > 0:
@@ -129,8 +129,9 @@ def simulate_truth(case, ephemeris, rng) -> Truth:
     nominal = ForceModel("earth", [PointMasses(["moon", "sun"]), SolarRadiationPressure(surfaces=model_body(sc))],
                          mass=sc.mass_kg, ephemeris=ephemeris)
     surfaces, axis = model_body(sc), np.asarray(sc.spin_axis, float) / np.linalg.norm(sc.spin_axis)
+    w = rng.standard_normal(3)    # drawn with or without a real body: the same random stream either way
     if case.truth_body is not None:
-        surfaces, axis = real_body(sc, case.truth_body, rng)
+        surfaces, axis = real_body(sc, case.truth_body, w)
     un = case.unmodelled
     extra = [] if un is None else outgassing(un, axis, t0, t1)
     gaps = tuple(np.asarray(sk.gap_days, float) * SECONDS_PER_DAY)
