@@ -2,12 +2,15 @@
 
 Each entry of :data:`SOURCES` names an error source of the thesis' budget (seed 004 ch. 4) the
 twin carries and turns it off in a :class:`~odpipe.simulate.case.Case` (``benchmarks/artemis_ablation.py``
-refits the case once per entry and reports what each contributes).
+refits the case once per entry and reports what each contributes). A source is set to zero, not removed,
+so that the same random numbers are drawn: the variants differ by the source only, not by the noise.
 """
 
 from __future__ import annotations
 
 from dataclasses import replace
+
+import numpy as np
 
 
 def _unmodelled(case, **changes):
@@ -15,7 +18,8 @@ def _unmodelled(case, **changes):
 
 
 SOURCES = {
-    "real-body SRP (truth flies the filter's cylinder)": lambda c: replace(c, truth_body=None),
+    "real-body SRP (truth flies the filter's cylinder)": lambda c: replace(c, truth_body=replace(
+        c.truth_body, bus_side_m=np.pi * c.body.radius_m / 2, plate_area_m2=0.0, axis_tilt_deg=0.0)),
     "outgassing": lambda c: _unmodelled(c, outgassing_m_s2=0.0),
     "thruster plume": lambda c: _unmodelled(c, plume_fraction=0.0),
     "attitude burns known only by time (plan carries their delta-v)":

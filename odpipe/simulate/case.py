@@ -95,9 +95,10 @@ class StationKeeping:
     every_days: float = checked(positive)  # d between maneuvers
     gap_days: list[float] = checked(positive)  # d from a burn to its x-z crossing, tried in order
     horizon_days: float = checked(positive)  # d, search window past each gap
-    # navigation errors of the state the burns are designed on (operations design from OD, not the truth)
-    nav_sigma_m: float = checked(at_least(0.0), default=0.0)  # m per ICRF axis
-    nav_sigma_m_s: float = checked(at_least(0.0), default=0.0)  # m/s per ICRF axis
+    # navigation errors of the state the burns are designed on (operations design from OD; none: on the truth,
+    # and no draws are made)
+    nav_sigma_m: float | None = checked(at_least(0.0), default=None)  # m per ICRF axis
+    nav_sigma_m_s: float | None = checked(at_least(0.0), default=None)  # m/s per ICRF axis
 
 
 @dataclass(frozen=True)
@@ -126,10 +127,11 @@ class Media:
     sigma_wet_m: float = checked(at_least(0.0))  # m, per-day deviation of the zenith wet delay from the DSN model
     sigma_dry_m: float = checked(at_least(0.0))  # m, per-day deviation of the zenith dry delay
     sigma_ion_m: float = checked(at_least(0.0))  # m, S-band line-of-sight range delay scale per DSN pass (.ION cards)
-    # calibration errors: the true delays differ from the written cards by a random quadratic per card
-    error_wet_m: float = checked(at_least(0.0), default=0.0)  # m, zenith wet
-    error_dry_m: float = checked(at_least(0.0), default=0.0)  # m, zenith dry
-    error_ion_m: float = checked(at_least(0.0), default=0.0)  # m, S-band line of sight
+    # calibration errors: the true delays differ from the written cards by a random quadratic per card, RMS m
+    # (none: the cards are the truth, and no draws are made)
+    error_wet_m: float | None = checked(at_least(0.0), default=None)  # m, zenith wet
+    error_dry_m: float | None = checked(at_least(0.0), default=None)  # m, zenith dry
+    error_ion_m: float | None = checked(at_least(0.0), default=None)  # m, S-band line of sight
 
 
 @dataclass(frozen=True)

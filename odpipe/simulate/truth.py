@@ -129,9 +129,8 @@ def simulate_truth(case, ephemeris, rng) -> Truth:
     nominal = ForceModel("earth", [PointMasses(["moon", "sun"]), SolarRadiationPressure(surfaces=model_body(sc))],
                          mass=sc.mass_kg, ephemeris=ephemeris)
     surfaces, axis = model_body(sc), np.asarray(sc.spin_axis, float) / np.linalg.norm(sc.spin_axis)
-    w = rng.standard_normal(3)    # drawn with or without a real body: the same random stream either way
     if case.truth_body is not None:
-        surfaces, axis = real_body(sc, case.truth_body, w)
+        surfaces, axis = real_body(sc, case.truth_body, rng.standard_normal(3))
     un = case.unmodelled
     extra = [] if un is None else outgassing(un, axis, t0, t1)
     gaps = tuple(np.asarray(sk.gap_days, float) * SECONDS_PER_DAY)
@@ -152,8 +151,10 @@ def simulate_truth(case, ephemeris, rng) -> Truth:
         t = float(utc_to_tdb(m["epoch"]))
         if m["dv"] is None:
             state = propagate(x0, t0, t, flown(), with_stm=False).state(t)[0]
-            nav = np.concatenate([sk.nav_sigma_m * rng.standard_normal(3), sk.nav_sigma_m_s * rng.standard_normal(3)])
-            m["dv"] = design_dv(nominal, state + nav, t, gaps, horizon)
+            if sk.nav_sigma_m is not None or sk.nav_sigma_m_s is not None:
+                state = state + np.concatenate([(sk.nav_sigma_m or 0.0) * rng.standard_normal(3),
+                                                (sk.nav_sigma_m_s or 0.0) * rng.standard_normal(3)])
+            m["dv"] = design_dv(nominal, state, t, gaps, horizon)
         executed.append((t, executed_dv(m["dv"], ex.sigma_magnitude, np.radians(ex.sigma_pointing_deg), rng)[0]))
     fm = flown()
     traj = propagate(x0, t0, t1, fm, with_stm=False)
