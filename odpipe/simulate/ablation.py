@@ -26,7 +26,6 @@ SOURCES = {
         lambda c: replace(c, maneuvers=[dict(m, planned=True) for m in c.maneuvers]),
     "media calibration errors": lambda c: replace(c, media=replace(c.media, error_wet_m=0.0, error_dry_m=0.0,
                                                                    error_ion_m=0.0)),
-    "stochastic accelerations": lambda c: replace(c, stochastic=replace(c.stochastic, sigma=0.0)),
     "burns designed on an OD state (on the truth)":
         lambda c: replace(c, station_keeping=replace(c.station_keeping, nav_sigma_m=0.0, nav_sigma_m_s=0.0)),
 }
