@@ -7,9 +7,13 @@
    maneuvers, and long arcs each spanning one station-keeping maneuver.
 3. Fit every arc with ``odpipe run`` on a local Dask cluster (resumable).
 4. Overlap precision (RIC, 3D RMS) of consecutive short and long arcs, the
-   maneuver reconstruction (designed vs estimated, Table 4.4; estimated vs the
-   executed truth), and the truth comparison of every arc (actual errors against
-   the reported covariance), all in one HTML report.
+   maneuver reconstruction (designed vs estimated station keeping, Table 4.4; estimated
+   vs the executed truth), the truth comparison of every arc (actual errors against
+   the reported covariance), and all of it beside the thesis' figures
+   (:mod:`odpipe.simulate.thesis`), in one HTML report.
+
+``odpipe demo --twin`` runs ``runs/artemis_p2_twin.toml`` instead: the ARTEMIS-P2 twin with the
+thesis' error budget (issue #25), ~10 min on 2 cores against the fast case's ~40 s.
 
 The a priori state of each arc is the truth at its start displaced by 1 km and
 1 cm/s (in operations, the previous arc's prediction); the filter's a priori
