@@ -15,13 +15,16 @@ _log = logging.getLogger(__name__)
 def add_arguments(p):
     p.add_argument("-o", "--out", type=Path, default=Path("out/demo"), help="output folder")
     p.add_argument("--workers", type=int, default=2, help="local Dask workers")
+    p.add_argument("--twin", action="store_true",
+                   help="the ARTEMIS-P2 twin with the thesis' error budget (runs/artemis_p2_twin.toml, ~10 min)")
 
 
 def run(args) -> int:
-    from odpipe.pipeline.demo import run_demo
+    from odpipe.pipeline.demo import TWIN, run_demo
+    from odpipe.simulate.case import load
 
     t0 = time.perf_counter()
-    headline = run_demo(args.out, args.workers, progress=_log.info)
+    headline = run_demo(args.out, args.workers, progress=_log.info, case=load(TWIN) if args.twin else None)
     print("\n".join(f"{k}: {v}" for k, v in headline.items()))
     _log.info("demo finished in %.0f s; open %s", time.perf_counter() - t0, headline["report"])
     return Exit.OK

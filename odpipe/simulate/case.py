@@ -33,10 +33,12 @@ def _networks(value: list) -> list[tuple[str, str]]:
 
 @dataclass(frozen=True)
 class Orbit:
-    """A planar CRTBP Lyapunov orbit, put into the ephemeris' Earth-Moon geometry at the start."""
+    """A CRTBP libration orbit about L1/L2 (odpipe.simulate.libration), put into the ephemeris' Earth-Moon geometry
+    at the start: the planar Lyapunov orbit, started ``z_amplitude`` out of the plane (0: planar)."""
 
     point: Literal[1, 2]  # Earth-Moon L1 or L2
-    amplitude: float = checked(positive)  # CRTBP length units (Earth-Moon distances)
+    amplitude: float = checked(positive)  # CRTBP length units (Earth-Moon distances) Earthward of the point at the start
+    z_amplitude: float = checked(at_least(0.0), default=0.0)  # CRTBP length units, z at the start; 0: planar
 
 
 @dataclass(frozen=True)
@@ -51,6 +53,28 @@ class SpacecraftModel:
     spin_axis: list[float] = checked(_vector)  # ICRF direction [x, y, z], fixed
     spin_rpm: float = checked(at_least(0.0), default=0.0)  # revolutions per minute
     antenna_offset_m: float = checked(at_least(0.0), default=0.0)  # m off the spin axis; 0: no spin signature
+
+
+@dataclass(frozen=True)
+class TruthBody:
+    """How the real spin-stabilised body differs from the filter's cylinder ([spacecraft_model]), truth only:
+    a square bus (spin-averaged: a cylinder of width 4/pi its side) with one-sided top and bottom plates, its
+    spin axis tilted from the nominal one by ``axis_tilt_deg`` (one draw of the direction)."""
+
+    bus_side_m: float = checked(positive)  # m, side of the square bus (its length is the model's length_m)
+    plate_area_m2: float = checked(at_least(0.0))  # m^2, each of the top and bottom plates (normals +-axis)
+    axis_tilt_deg: float = checked(at_least(0.0))  # deg, spin axis off the nominal direction
+
+
+@dataclass(frozen=True)
+class Unmodelled:
+    """Truth-only accelerations the filter has no model of: outgassing along the spin axis (exponential decay)
+    and a thruster-plume acceleration after every burn (along its delta-v, constant for ``plume_hours``)."""
+
+    outgassing_m_s2: float = checked(at_least(0.0))  # m/s^2 at the start, along the spin axis
+    outgassing_tau_days: float = checked(positive)  # d, e-folding time of the outgassing
+    plume_fraction: float = checked(at_least(0.0))  # delta-v added by the plume after a burn, fraction of its |dv|
+    plume_hours: float = checked(positive)  # h over which the plume delta-v is spread
 
 
 @dataclass(frozen=True)
@@ -71,6 +95,10 @@ class StationKeeping:
     every_days: float = checked(positive)  # d between maneuvers
     gap_days: list[float] = checked(positive)  # d from a burn to its x-z crossing, tried in order
     horizon_days: float = checked(positive)  # d, search window past each gap
+    # navigation errors of the state the burns are designed on (operations design from OD; none: on the truth,
+    # and no draws are made)
+    nav_sigma_m: float | None = checked(at_least(0.0), default=None)  # m per ICRF axis
+    nav_sigma_m_s: float | None = checked(at_least(0.0), default=None)  # m/s per ICRF axis
 
 
 @dataclass(frozen=True)
@@ -81,6 +109,7 @@ class Maneuver:
     epoch: str = checked(utc_time)  # UTC ISO time
     kind: str  # e.g. "attitude"
     dv: list[float] = checked(lambda v: _vector(v) + finite(v))  # designed delta-v, ICRF m/s
+    planned_dv: bool = False  # the maneuver plan carries its delta-v (false: its time only, delta-v 0)
 
 
 @dataclass(frozen=True)
@@ -98,6 +127,11 @@ class Media:
     sigma_wet_m: float = checked(at_least(0.0))  # m, per-day deviation of the zenith wet delay from the DSN model
     sigma_dry_m: float = checked(at_least(0.0))  # m, per-day deviation of the zenith dry delay
     sigma_ion_m: float = checked(at_least(0.0))  # m, S-band line-of-sight range delay scale per DSN pass (.ION cards)
+    # calibration errors: the true delays differ from the written cards by a random quadratic per card, RMS m
+    # (none: the cards are the truth, and no draws are made)
+    error_wet_m: float | None = checked(at_least(0.0), default=None)  # m, zenith wet
+    error_dry_m: float | None = checked(at_least(0.0), default=None)  # m, zenith dry
+    error_ion_m: float | None = checked(at_least(0.0), default=None)  # m, S-band line of sight
 
 
 @dataclass(frozen=True)
@@ -121,6 +155,7 @@ class Network:
     sigma_range: float = checked(positive, default=2.0)  # m, range noise
     range_bias_sigma: float = checked(at_least(0.0), default=0.0)  # m, range bias, one draw per pass
     ramp_rate_sigma: float = checked(at_least(0.0), default=0.0)  # Hz/s, uplink ramp rate per pass; > 0: ramped
+    fitted: bool = True  # its data go into the demo's fits (false: simulated and written only)
 
 
 @dataclass(frozen=True)
@@ -143,12 +178,16 @@ class CaseFile:
     network: list[Network] = checked(_networks)
     # maneuvers with a given delta-v, besides the station keeping
     maneuver: list[Maneuver] = field(default_factory=list)
+    # the real body's differences from the model (none: the truth flies the model's body)
+    truth_body: TruthBody | None = None
+    # truth-only accelerations (none: none)
+    unmodelled: Unmodelled | None = None
 
 
 @dataclass(frozen=True)
 class Case:
     """A loaded case: the file's sections, times as UTC datetime64[ns], maneuvers in time order as dicts
-    (name, epoch, kind, dv: ICRF m/s array)."""
+    (name, epoch, kind, dv: ICRF m/s array, planned: whether the plan carries the delta-v)."""
 
     name: str
     seed: int
@@ -164,6 +203,8 @@ class Case:
     media: Media
     station_keeping: StationKeeping
     networks: tuple = field(default_factory=tuple)
+    truth_body: TruthBody | None = None
+    unmodelled: Unmodelled | None = None
 
     @property
     def end(self) -> np.datetime64:
@@ -190,11 +231,12 @@ def load(path) -> Case:
     path = Path(path)
     data, text = read_toml(path)
     f = load_schema(CaseFile, data, path, text=text)
-    mans = [{"name": m.name, "epoch": _utc(m.epoch), "kind": m.kind, "dv": np.asarray(m.dv, float)}
+    mans = [{"name": m.name, "epoch": _utc(m.epoch), "kind": m.kind, "dv": np.asarray(m.dv, float),
+             "planned": m.planned_dv}
             for m in f.maneuver]
     return Case(f.name, f.seed, _utc(f.start), f.days, f.spacecraft, f.naif_id, f.orbit, f.spacecraft_model,
                 f.stochastic, sorted(mans, key=lambda m: m["epoch"]), f.execution, f.media, f.station_keeping,
-                tuple(f.network))
+                tuple(f.network), f.truth_body, f.unmodelled)
 
 
 def reference() -> str:

@@ -135,9 +135,14 @@ def tdm_data(table: pd.DataFrame, to_los: np.ndarray, created: np.datetime64) ->
 
 
 def maneuver_plan(maneuvers, dv=None) -> pd.DataFrame:
-    """Maneuvers (designed, or ``dv`` (K,3) instead) in the parsers.maneuvers plan schema (ICRF, impulsive)."""
+    """Maneuvers (as planned, or ``dv`` (K,3) instead) in the parsers.maneuvers plan schema (ICRF, impulsive).
+
+    As planned (thesis §4.2.4): station keeping with its designed delta-v; other burns (attitude) with their
+    time only, delta-v 0, unless the case says ``planned_dv`` (a priori sigma 1 mm/s against 10 mm/s for
+    station keeping, Table 4.1)."""
     rows = [{"name": m["name"], "epoch": m["epoch"], "kind": "impulsive", "frame": "ICRF",
-             "dv1": m["dv"][0], "dv2": m["dv"][1], "dv3": m["dv"][2],
+             **dict(zip(("dv1", "dv2", "dv3"), m["dv"] if m["kind"] == "station-keeping" or m.get("planned")
+                        else np.zeros(3))),
              "sigma_dv": 0.01 if m["kind"] == "station-keeping" else 0.001, "sigma_time": 10.0} for m in maneuvers]
     plan = pd.DataFrame(rows, columns=PLAN_COLUMNS).astype({c: float for c in PLAN_COLUMNS[4:]})
     if dv is not None:

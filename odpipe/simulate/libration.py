@@ -3,6 +3,9 @@
 The planar Lyapunov orbit is found by differential correction in the CRTBP
 (odpipe.dynamics.crtbp): start on the x axis with velocity along y, and
 correct vy0 until vx vanishes at the next x-axis crossing (half period).
+A three-dimensional (Lissajous-like) start adds an out-of-plane offset z0 to it
+(:func:`odpipe.simulate.truth.initial_state`): the vertical motion is a centre at
+a frequency close to the in-plane one, and the station keeping removes the unstable mode.
 A nondimensional rotating state is put into the real Earth-Moon geometry at
 an epoch with the instantaneous (pulsating) synodic frame of the ephemeris
 Moon: positions scaled by the Earth-Moon distance d, velocities by d|w|,
@@ -39,22 +42,26 @@ def lyapunov_orbit(mu: float, which: int, amplitude: float, iterations: int = 30
     vy = amplitude * (w**2 + 1 + 2 * c2) / 2                  # linear guess k*w*A, corrected below
     t_half = 1.4
     for _ in range(iterations):
-        s0 = np.array([x0, 0.0, 0.0, 0.0, vy, 0.0])
-        tr = propagate_crtbp(s0, 0.0, 4.0, mu, with_stm=True)
-        ts = np.linspace(0.5, 4.0, 3501)
-        y = tr.state(ts)[:, 1]
-        k = np.flatnonzero(np.sign(y[1:]) != np.sign(y[:-1]))[0]
-        t_half = _crossing(tr, ts[k], ts[k + 1])
-        st = tr.state(t_half)[0]
-        phi = tr.stm(t_half)[0]
-        acc = _crtbp_accel(st, mu)
+        t_half, st, phi, acc = _half_period(np.array([x0, 0.0, 0.0, 0.0, vy, 0.0]), mu)
         # d vx(t_half)/d vy0 with the crossing time moving to keep y = 0
-        d = phi[3, 4] - acc[0] * phi[1, 4] / st[4]
-        step = -st[3] / d
+        step = -st[3] / (phi[3, 4] - acc[0] * phi[1, 4] / st[4])
         vy += step
         if abs(step) < 1e-13:
             break
     return np.array([x0, 0.0, 0.0, 0.0, vy, 0.0]), 2.0 * t_half
+
+
+def _half_period(s0, mu):
+    """(t, state, STM, acceleration) at the first y = 0 crossing after t = 0.5 (nondim) of the CRTBP from ``s0``."""
+    tr = propagate_crtbp(s0, 0.0, 4.0, mu, with_stm=True)
+    ts = np.linspace(0.5, 4.0, 3501)
+    y = tr.state(ts)[:, 1]
+    k = np.flatnonzero(np.sign(y[1:]) != np.sign(y[:-1]))
+    if not k.size:
+        raise ValueError(f"no x-z plane crossing from {s0}")
+    t = _crossing(tr, ts[k[0]], ts[k[0] + 1])
+    st = tr.state(t)[0]
+    return t, st, tr.stm(t)[0], _crtbp_accel(st, mu)
 
 
 def _crossing(tr, a, b):
