@@ -16,5 +16,5 @@ DAY = 86400.0
     (14.0, None, []),                  # switched off
 ])
 def test_growing_arc_ends(days, growing, expected):
-    setup = SimpleNamespace(start=1000.0, end=1000.0 + days * DAY, growing_days=growing)
+    setup = SimpleNamespace(start=1000.0, end=1000.0 + days * DAY, growing_days=growing, maneuvers=())
     assert [(e - 1000.0) / DAY for e in growing_ends(setup)] == expected
