@@ -19,7 +19,10 @@ The grid holds the arc ends, a regular spacing (``block`` s), the batch
 boundaries of every stochastic parameter and any extra epochs (maneuvers). At a
 batch boundary the SRIF applies ``p+ = m p + w``; the measurements of each grid
 interval are absorbed in one Householder update, after an innovation k-sigma
-test against the filter's prediction.
+test against the filter's prediction; a row is edited when it also misses the
+reference (the last smoothed solution) by k of its sigma, so a row only the
+forward filter finds surprising (a burn's a priori overruled by the data) is
+kept and the filter is not locked out of the rows after it.
 
 Each iteration is one filter pass and one smoother pass about a reference; the
 next reference starts from the smoothed epoch vector and takes the smoothed
