@@ -7,7 +7,9 @@ Tolerances and why:
   ``odpipe demo --twin``): short-arc radial / in-track / cross-track overlap means within a factor 3 of
   15 / 183 / 416 m (the thesis' own overlap-to-overlap scatter is 50-80 % of its means, and the twin has 3
   short-arc overlaps against the thesis' ~16), the Table 4.4 median magnitude percentage within a factor 5
-  of 0.58 % (its burns are 3x the thesis' and its components ICRF, not true of date);
+  of 0.58 % (its burns are 3x the thesis' and its components ICRF, not true of date); long-arc overlap means
+  within a factor 10 of 5 / 66 / 102 m (measured 8.5 / 175 / 496 m; before the growing-arc and editing fixes
+  of odpipe.od.arc / odpipe.estimation.fit, long2 across SK-3 converged 114 km off and these were 30-45 km);
 * snapshot: the twin's first 14 days refitted live must give the recorded figures
   (fixtures/artemis/twin_14d_figures.csv) within 20 %: the runs are seeded, so only a change of the code moves
   them, and a several-fold change cannot pass.
@@ -107,6 +109,9 @@ def test_twin_recorded_figures_against_the_thesis():
     for c, limit in zip(thesis.COMPONENTS, (15.0, 183.0, 416.0)):
         ours = _mean(versus, f"short-arc position {c} (m)")
         assert limit / 3 < ours < limit * 3, (c, ours)
+    for c, limit in zip(thesis.COMPONENTS, (5.0, 66.0, 102.0)):
+        ours = _mean(versus, f"long-arc position {c} (m)")
+        assert limit / 10 < ours < limit * 10, (c, ours)
     pct = _mean(versus, "Table 4.4 median Mag. (%)")
     assert 0.58 / 5 < pct < 0.58 * 5, pct
 

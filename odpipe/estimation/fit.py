@@ -19,7 +19,10 @@ The grid holds the arc ends, a regular spacing (``block`` s), the batch
 boundaries of every stochastic parameter and any extra epochs (maneuvers). At a
 batch boundary the SRIF applies ``p+ = m p + w``; the measurements of each grid
 interval are absorbed in one Householder update, after an innovation k-sigma
-test against the filter's prediction.
+test against the filter's prediction; a row is edited when it also misses the
+reference (the last smoothed solution) by k of its sigma, so a row only the
+forward filter finds surprising (a burn's a priori overruled by the data) is
+kept and the filter is not locked out of the rows after it.
 
 Each iteration is one filter pass and one smoother pass about a reference; the
 next reference starts from the smoothed epoch vector and takes the smoothed
@@ -204,7 +207,10 @@ def _filter_smoother_pass(problem, obs, grid, steps, bounds, x_ref0, p_after, si
             use = ~nonfinite
             nu, s = np.full(rows.size, np.nan), np.full(rows.size, np.nan)
             nu[use], s[use] = srif.innovations(H[use], y[use], sig_row[rows][use])
-            bad = use & (np.abs(nu) > edit_k * s)
+            # an outlier to the forward filter that the last smoothed solution (the reference) fits too is
+            # no blunder, only a surprise (an unmodelled acceleration after a burn): edited it locks the filter out
+            bad = use.copy()
+            bad[use] = (np.abs(nu[use]) > edit_k * s[use]) & (np.abs(y[use]) > edit_k * sig_row[rows][use])
             flags[rows[bad]] |= EDIT_INNOVATION
             prefit[rows], innov[rows], innov_sig[rows] = y, nu, s
             keep = use & ~bad
@@ -234,10 +240,12 @@ def _estimate(ps: _Pass, R, z):
 
 
 def fit(problem: Problem, obs: Observations, t_start: float, t_end: float,
-        options: FitOptions = FitOptions(), x_ref=None) -> Solution:
+        options: FitOptions = FitOptions(), x_ref=None, earlier: Solution | None = None) -> Solution:
     """Iterated filter-smoother fit of ``obs`` over ``[t_start, t_end]`` (TDB s).
 
-    ``x_ref``: initial reference vector (default: the registry's a priori values).
+    ``x_ref``: initial reference vector (default: the registry's a priori values); ``earlier``: a fit
+    of a shorter arc whose smoothed stochastic values after its batch boundaries start the reference
+    there (otherwise their a priori mean: over an unstable orbit far from the earlier fit's solution).
     Rows outside the arc are flagged ``OUTSIDE_ARC`` and not used.
     """
     reg = problem.registry
@@ -251,6 +259,11 @@ def fit(problem: Problem, obs: Observations, t_start: float, t_end: float,
     groups = np.unique(obs.group)
     scale = {g: 1.0 for g in groups}
     p_after = {}           # (grid index, group) -> reference stochastic values after the step
+    if earlier is not None:
+        for k, group in steps.items():
+            i = int(np.searchsorted(earlier.grid, grid[k]))
+            if i < earlier.grid.size and earlier.grid[i] == grid[k]:
+                p_after.update({(k, j): earlier.smoothed_x[i][idx] for j, (idx, _) in enumerate(group)})
     history, prev_rms, converged = [], None, False
     stage, last_stage = 0, len(options.sigma_scale) - 1
     last_step, halvings, stage_start = None, 0, False

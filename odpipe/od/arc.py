@@ -358,29 +358,38 @@ def fit_arc(table: pd.DataFrame, setup: ArcSetup, shared: dict | None = None) ->
     sig = data_sigma(used, setup.data_sigma) / np.abs(np.where(used["unit"] == "rad", 1.0, to_los[good]))
     group = (used["observable"] + ":" + used["station_rx"].astype(str)).to_numpy(object)
     obs = Observations(times[good], used["value"].to_numpy(float), sig, group)
-    x_ref, history = None, []
+    grown, history = None, []
     for end in growing_ends(setup):  # unstable orbits: reach the full arc through shorter ones
-        grown = fit(problem, obs, setup.start, end, replace(options, edit_k=(np.inf,)), x_ref=x_ref)
-        x_ref, history = grown.x0, history + labelled([{**h, "window": (setup.start, end)} for h in grown.history],
-                                                       "growing arc")
-    sol = fit(problem, obs, setup.start, setup.end, options, x_ref=x_ref)
+        grown = fit(problem, obs, setup.start, end, replace(options, edit_k=(np.inf,)),
+                    x_ref=None if grown is None else grown.x0, earlier=grown)
+        history += labelled([{**h, "window": (setup.start, end)} for h in grown.history], "growing arc")
+    sol = fit(problem, obs, setup.start, setup.end, options, x_ref=None if grown is None else grown.x0,
+              earlier=grown)
     sol.history = history + sol.history   # every fit's iterations (odpipe.od.outward.iteration_stages)
     return _solution(setup, reg, problem, sol, rows, times, to_los, status, rows["value"].to_numpy(float) - computed)
 
 
 def growing_ends(setup: ArcSetup) -> list[float]:
-    """Ends (TDB s) of the shorter arcs fitted first: ``growing_days``, doubling, below the arc's end.
+    """Ends (TDB s) of the shorter arcs fitted first: ``growing_days``, doubling, below the arc's end, and
+    again from every maneuver inside the arc.
 
     Over a long arc of an unstable orbit (libration orbits) an a priori a kilometre off is far outside the
     linear regime at the arc's end; each fit starts from the previous one's smoothed epoch estimate and
-    the original a priori, so nothing is counted twice.
+    the original a priori, so nothing is counted twice. A burn known to its a priori sigma (10 mm/s, Table
+    4.1) leaves the orbit after it as uncertain as at an arc's start: the doubling restarts there, so no
+    window ends hours after a burn and is then extrapolated days past it.
     """
     if not setup.growing_days:
         return []
-    ends, d = [], setup.growing_days
-    while setup.start + d * SECONDS_PER_DAY < setup.end - 0.5 * d * SECONDS_PER_DAY:
-        ends.append(setup.start + d * SECONDS_PER_DAY)
-        d *= 2.0
+    d0 = setup.growing_days * SECONDS_PER_DAY
+    burns = sorted({m.epoch for m in setup.maneuvers if setup.start < m.epoch < setup.end})
+    starts = [setup.start] + burns
+    ends = []
+    for a, b in zip(starts, starts[1:] + [setup.end]):
+        d = d0
+        while a + d < min(b, setup.end - 0.5 * d):
+            ends.append(a + d)
+            d *= 2.0
     return ends
 
 
