@@ -19,10 +19,11 @@ The grid holds the arc ends, a regular spacing (``block`` s), the batch
 boundaries of every stochastic parameter and any extra epochs (maneuvers). At a
 batch boundary the SRIF applies ``p+ = m p + w``; the measurements of each grid
 interval are absorbed in one Householder update, after an innovation k-sigma
-test against the filter's prediction; a row is edited when it also misses the
-reference (the last smoothed solution) by k of its sigma, so a row only the
-forward filter finds surprising (a burn's a priori overruled by the data) is
-kept and the filter is not locked out of the rows after it.
+test against the filter's prediction; with ``edit_against_reference`` a row is
+edited only when it also misses the reference (the last smoothed solution) by k
+of its sigma, so a row only the forward filter finds surprising (a burn's a
+priori overruled by the data) is kept and the filter is not locked out of the
+rows after it.
 
 Each iteration is one filter pass and one smoother pass about a reference; the
 next reference starts from the smoothed epoch vector and takes the smoothed
@@ -98,7 +99,11 @@ class FitOptions:
     the post-fit RMS changed by < tol_rms (relative; in sigma below an RMS of 1, where noise
     absorbed by process noise leaves changes of 1e-4 sigma that mean nothing); extra_epochs: more grid epochs (TDB s);
     output_at_measurements: put every observation time on the grid, so filtered and
-    smoothed estimates exist at each measurement time."""
+    smoothed estimates exist at each measurement time. edit_against_reference: edit a row
+    only when it misses the reference (the last smoothed solution) by edit_k of its sigma as
+    well as the filter's prediction (arcs across burns with unmodelled accelerations after
+    them); off, the innovation test alone edits (GRAIL-B's first arc, kilometres off at the
+    start: with both tests its edits swung between iterations and it did not converge)."""
 
     max_iter: int = 10
     block: float = 600.0
@@ -113,6 +118,7 @@ class FitOptions:
     tol_rms: float = 1e-3
     extra_epochs: tuple = ()
     output_at_measurements: bool = False
+    edit_against_reference: bool = False
 
 
 def build_grid(registry, t_start, t_end, block, extra=()) -> tuple[np.ndarray, dict]:
@@ -177,7 +183,8 @@ def _unusable(obs: Observations) -> np.ndarray:
     return ~np.isfinite(obs.value) | ~np.isfinite(obs.sigma) | ~(obs.sigma > 0)
 
 
-def _filter_smoother_pass(problem, obs, grid, steps, bounds, x_ref0, p_after, sig_row, edit_k):
+def _filter_smoother_pass(problem, obs, grid, steps, bounds, x_ref0, p_after, sig_row, edit_k,
+                          against_reference=False):
     reg = problem.registry
     m_obs = obs.time.size
     flags = np.zeros(m_obs, int)
@@ -210,7 +217,9 @@ def _filter_smoother_pass(problem, obs, grid, steps, bounds, x_ref0, p_after, si
             # an outlier to the forward filter that the last smoothed solution (the reference) fits too is
             # no blunder, only a surprise (an unmodelled acceleration after a burn): edited it locks the filter out
             bad = use.copy()
-            bad[use] = (np.abs(nu[use]) > edit_k * s[use]) & (np.abs(y[use]) > edit_k * sig_row[rows][use])
+            bad[use] = np.abs(nu[use]) > edit_k * s[use]
+            if against_reference:
+                bad[use] &= np.abs(y[use]) > edit_k * sig_row[rows][use]
             flags[rows[bad]] |= EDIT_INNOVATION
             prefit[rows], innov[rows], innov_sig[rows] = y, nu, s
             keep = use & ~bad
@@ -276,7 +285,8 @@ def fit(problem: Problem, obs: Observations, t_start: float, t_end: float,
         stage_start = False
         for halving in range(options.max_halvings + 1):
             try:
-                ps = _filter_smoother_pass(problem, obs, grid, steps, bounds, x_ref0, p_after, sig_row, kk)
+                ps = _filter_smoother_pass(problem, obs, grid, steps, bounds, x_ref0, p_after, sig_row, kk,
+                                           options.edit_against_reference)
                 break
             except (RuntimeError, ValueError) as err:  # e.g. an orbit driven into the body, light time off its span
                 if last_step is None or halving == options.max_halvings:

@@ -121,6 +121,7 @@ class ArcSetup:
     sigma_scale: tuple = FitOptions.sigma_scale
     block: float = FitOptions.block
     measurement_epochs: bool = FitOptions.output_at_measurements
+    edit_against_reference: bool = FitOptions.edit_against_reference
     lookback: float = 120.0
     growing_days: float | None = 2.0  # first span of the growing-arc start (None: fit the whole arc at once)
     tabulate_earth_rotation: bool = True
@@ -332,7 +333,8 @@ def fit_arc(table: pd.DataFrame, setup: ArcSetup, shared: dict | None = None) ->
     reg = build_registry(setup, rows)
     options = FitOptions(max_iter=setup.max_iter, block=setup.block, edit_k=tuple(setup.edit_k),
                          reweight=setup.reweight, sigma_scale=tuple(setup.sigma_scale),
-                         output_at_measurements=setup.measurement_epochs)
+                         output_at_measurements=setup.measurement_epochs,
+                         edit_against_reference=setup.edit_against_reference)
     grid, _ = build_grid(reg, setup.start, setup.end, options.block, options.extra_epochs)
 
     meas = setup.measurements

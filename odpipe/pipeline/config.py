@@ -372,6 +372,9 @@ class EstimationSection:
     # every measurement epoch on the filter grid too: one update per epoch, so the innovations are a
     # sequential filter's, measurement by measurement (Orekit's Kalman); false: the rows of a block at once
     measurement_epochs: bool = FitOptions.output_at_measurements
+    # edit a row only when it misses the last smoothed solution as well as the filter's prediction (arcs across
+    # burns with unmodelled accelerations after them); false: the innovation test alone (a far-off start)
+    edit_against_reference: bool = FitOptions.edit_against_reference
     # unlogged maneuvers: the filter's innovations are always tested (findings in the report); with a sigma
     # (m/s per axis) each finding also becomes an estimated impulsive maneuver and the arc is fitted again
     detected_maneuver_sigma: float | None = checked(positive, default=None)

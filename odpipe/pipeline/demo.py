@@ -125,6 +125,7 @@ state = {list(map(float, x0))}
 stochastic = {{ sigma = {case.stochastic.sigma}, tau = {case.stochastic.tau_s}, batch = {case.stochastic.batch_s} }}
 data_sigma = {{ {sig} }}
 maneuver_plan = "../case/{Path(files['maneuvers']).name}"
+edit_against_reference = true   # arcs across burns: the plume after one must not lock the filter out
 [products]
 naif_id = {case.naif_id}
 step = 600.0

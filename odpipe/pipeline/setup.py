@@ -169,7 +169,8 @@ def arc_setup(cfg: RunConfig, fm: F.ForceModel, ramps, catalog: StationCatalog) 
                     oscillator_sigma=None if est.oscillator_sigma is None else tuple(est.oscillator_sigma),
                     edit_k=tuple(est.edit_k), max_iter=est.max_iter, reweight=est.reweight,
                     sigma_scale=tuple(est.sigma_scale), block=est.block,
-                    measurement_epochs=est.measurement_epochs)
+                    measurement_epochs=est.measurement_epochs,
+                    edit_against_reference=est.edit_against_reference)
 
 
 def bias_apriori(est) -> dict:
