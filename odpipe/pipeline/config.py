@@ -152,6 +152,24 @@ class CalibrationSection:
 
 
 @dataclass
+class EditWindowSection:
+    """Rows the analyst removes (flag USER), with the reason on record: tagged in [start, end] (UTC),
+    optionally only one receiving station and observable."""
+
+    start: str = checked(utc_time)
+    end: str = checked(utc_time)
+    reason: str  # why the rows are removed (what shows they are wrong), kept in the configuration
+    station_rx: str = ""  # e.g. "DSS-14"; empty: every station
+    observable: str = ""  # e.g. "range"; empty: every observable
+
+    def problems(self):
+        if _utc(self.end) < _utc(self.start):
+            yield "end", f"{self.end} is before the start {self.start}"
+        if not self.reason.strip():
+            yield "reason", "say why the rows are removed"
+
+
+@dataclass
 class PreprocessSection:
     count_time: float = checked(positive, default=60.0)  # s, Doppler compression target
     # compressed windows cut short (gaps, ramp segments): keep them, flag them, or drop them
@@ -161,6 +179,7 @@ class PreprocessSection:
     # robust sigmas of a pass's a priori residuals, detrended the same way: BLUNDER (none: not tested)
     apriori_blunder_k: float | None = checked(positive, default=None)
     min_pass_samples: int = checked(at_least(1), default=10)  # passes with fewer rows are flagged SHORT_PASS
+    edit_windows: list[EditWindowSection] = field(default_factory=list)  # analyst edits (flag USER), each with its reason
 
 
 @dataclass

@@ -137,7 +137,7 @@ def _run(cfg: RunConfig, attempt, log: RunLog, fingerprint: dict) -> dict:
     table = table[fitted_rows(table, cfg.data.observables)].reset_index(drop=True)  # after: counts -> Hz
     log(f"observables fitted: {', '.join(f'{k} {v}' for k, v in table['observable'].value_counts().items())}")
     edit_cfg = EditConfig(min_elevation=np.radians(pre.elevation_mask_deg), blunder_k=pre.blunder_k,
-                          min_pass_samples=pre.min_pass_samples,
+                          min_pass_samples=pre.min_pass_samples, windows=[vars(w) for w in pre.edit_windows],
                           arc=(np.datetime64(cfg.arc.start, "ns"), np.datetime64(cfg.arc.end, "ns")))
     table, edits = edit(table, data.ramps, edit_cfg)
     log("edit: " + ", ".join(f"{r} {n}" for r, n in zip(edits["reason"], edits["rows"]) if n))
