@@ -156,8 +156,8 @@ class EditWindowSection:
     """Rows the analyst removes (flag USER), with the reason on record: tagged in [start, end] (UTC),
     optionally only one receiving station and observable."""
 
-    start: str = checked(utc_time)
-    end: str = checked(utc_time)
+    start: str = checked(utc_time)  # UTC ISO time, first tag removed
+    end: str = checked(utc_time)  # UTC ISO time, last tag removed
     reason: str  # why the rows are removed (what shows they are wrong), kept in the configuration
     station_rx: str = ""  # e.g. "DSS-14"; empty: every station
     observable: str = ""  # e.g. "range"; empty: every observable
