@@ -19,9 +19,10 @@ from odpipe.frames.earth import gcrs_to_itrs
 from odpipe.frames.moon import moon_pa_to_icrf
 from odpipe.measurements import MeasurementSetup
 from odpipe.od.apriori import AprioriResult, determine_orbit, doppler_rows
+from odpipe.od.flyby_apriori import FlybyApriori, determine_flyby_orbit
 from odpipe.pipeline.config import DopplerAprioriSection, RunConfig
 from odpipe.pipeline.ingest import ingest
-from odpipe.pipeline.setup import station_catalog
+from odpipe.pipeline.setup import station_catalog, tdb
 from odpipe.operations.schema import ConfigError
 from odpipe.time import tdb_to_utc
 
@@ -61,6 +62,42 @@ def doppler_apriori(cfg: RunConfig, how: DopplerAprioriSection | None = None) ->
                          ephemeris=Ephemeris.open(str(cfg.dynamics.ephemeris)), central_gm=field.gm)
     setup = MeasurementSetup(model.ephemeris, catalog, ramps=data.store, gcrs_to_itrs=gcrs_to_itrs)
     return determine_orbit(rows, setup, model, cfg.arc.spacecraft, FRAMES[center], F.BODY_RADIUS[center]), rows
+
+
+def flyby_search(cfg: RunConfig) -> FlybyApriori:
+    """The flyby search of ``cfg``'s ``initial_state.from_flyby`` on the arc's two-way Doppler
+    (:func:`determine_flyby_orbit`): the state about the flown-by body, its closest approach and candidates."""
+    how = cfg.initial_state.from_flyby
+    key = "initial_state.from_flyby"
+    eph = Ephemeris.open(str(cfg.dynamics.ephemeris))
+    body = how.body.lower()
+    try:
+        eph.state(body, cfg.dynamics.center.lower(), np.array([tdb(how.epoch)]))
+    except (KeyError, ValueError) as err:
+        raise ConfigError(cfg.path, f"{key}.body", f"{how.body!r} is not in {cfg.dynamics.ephemeris}: {err}")
+    data = ingest(list(cfg.data.files), spacecraft=cfg.arc.spacecraft)
+    catalog = station_catalog(cfg)
+    rows = doppler_rows(data.table, data.ramps, cfg.arc.spacecraft)
+    rows = rows[(rows["epoch"] >= pd.Timestamp(cfg.arc.start)) & (rows["epoch"] <= pd.Timestamp(cfg.arc.end))
+                & rows["station_rx"].isin(catalog.stations)].reset_index(drop=True)
+    if rows.empty:
+        raise ConfigError(cfg.path, "data.files", f"no two-way Doppler of spacecraft {cfg.arc.spacecraft} from a "
+                                                  f"catalogued station between {cfg.arc.start} and {cfg.arc.end}")
+    model = F.ForceModel(body, [F.PointMasses([b for b in how.perturbers if b.lower() != body])], ephemeris=eph)
+    setup = MeasurementSetup(eph, catalog, ramps=data.store, gcrs_to_itrs=gcrs_to_itrs)
+    try:
+        return determine_flyby_orbit(rows, setup, model, tdb(how.epoch))
+    except RuntimeError as err:
+        raise ConfigError(cfg.path, key, f"no orbit flies by {how.body} at {how.epoch}: {err}")
+
+
+def flyby_apriori(cfg: RunConfig, found: FlybyApriori | None = None) -> tuple[float, np.ndarray]:
+    """The a priori epoch (TDB s, the first Doppler point's) and state (m, m/s, ICRF about dynamics.center) of
+    ``cfg``'s arc from its two-way Doppler and ``initial_state.from_flyby`` (``found``: that search's result)."""
+    found = found or flyby_search(cfg)
+    eph = Ephemeris.open(str(cfg.dynamics.ephemeris))
+    center = eph.state(cfg.initial_state.from_flyby.body.lower(), cfg.dynamics.center.lower(), np.array([found.epoch]))
+    return found.epoch, found.state + center[0]
 
 
 def initial_state_toml(result: AprioriResult) -> str:

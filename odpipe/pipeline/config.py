@@ -284,26 +284,39 @@ class DopplerAprioriSection:
 
 
 @dataclass
+class FlybyAprioriSection:
+    """How the a priori orbit is found in the arc's two-way Doppler and a flyby's epoch, for a spacecraft in
+    cruise towards a planet (:mod:`odpipe.od.flyby_apriori`); its epoch is the first Doppler point's."""
+
+    body: str  # the planet flown by, e.g. "venus" (its gm and ephemeris from dynamics.ephemeris)
+    epoch: str = checked(utc_time)  # UTC ISO time of closest approach (published), e.g. "2007-06-05T23:08:00"
+    # point masses perturbing the approach in the search (the run's full force model takes over after it)
+    perturbers: list[str] = field(default_factory=lambda: ["sun", "earth", "mercury", "jupiter"])
+
+
+@dataclass
 class InitialStateSection:
     """The a priori state at ``epoch``: given (``state``) or read from an OEM (``from_oem``), e.g. the
     previous arc's ``OUTPUT/NAME/current/trajectory.oem`` (a nightly chain; ``odpipe batch`` runs
     that arc first, so the file need not exist when the configuration is loaded)."""
 
-    epoch: str | None = checked(utc_time, default=None)  # UTC ISO time of the state (from_doppler: none)
+    epoch: str | None = checked(utc_time, default=None)  # UTC ISO time of the state (from_doppler/from_flyby: none)
     state: list[float] | None = None  # m, m/s, ICRF axes about dynamics.center
     from_oem: Path | None = None  # OEM whose state at epoch is the a priori (e.g. the previous arc's)
     # find the a priori orbit in the arc's own two-way Doppler (odpipe apriori); its epoch is the data's
     from_doppler: DopplerAprioriSection | None = None
+    # find it in the arc's own two-way Doppler and a planetary flyby's epoch; its epoch is the data's
+    from_flyby: FlybyAprioriSection | None = None
     # axes of ``state``: "ICRF" (GCRS about the Earth) or "EME2000" (mean equator and equinox of J2000,
     # turned to ICRF by the IAU 2006 frame bias)
     frame: Literal["ICRF", "EME2000"] = "ICRF"
 
     def problems(self):
-        if sum(x is not None for x in (self.state, self.from_oem, self.from_doppler)) != 1:
-            yield "", "give one of state, from_oem or from_doppler"
+        if sum(x is not None for x in (self.state, self.from_oem, self.from_doppler, self.from_flyby)) != 1:
+            yield "", "give one of state, from_oem, from_doppler or from_flyby"
         elif self.state is not None and (len(self.state) != 6 or not np.all(np.isfinite(self.state))):
             yield "state", "needs 6 finite numbers (m, m/s)"
-        if self.epoch is None and self.from_doppler is None:
+        if self.epoch is None and self.from_doppler is None and self.from_flyby is None:
             yield "epoch", "required key is missing"
         if self.frame != "ICRF" and self.state is None:
             yield "frame", "only a given state takes a frame (an OEM names its own; from_doppler is ICRF)"

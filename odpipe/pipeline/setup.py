@@ -117,6 +117,10 @@ def initial_state(cfg: RunConfig) -> tuple[float, np.ndarray]:
 
         result, _ = doppler_apriori(cfg)
         return result.epoch, result.state
+    if init.from_flyby is not None:
+        from odpipe.pipeline.apriori import flyby_apriori
+
+        return flyby_apriori(cfg)
     t_tdb = tdb(init.epoch)
     if init.from_oem is None:
         return t_tdb, (eme2000_to_gcrs(init.state) if init.frame == "EME2000" else np.asarray(init.state, float))
