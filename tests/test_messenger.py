@@ -22,6 +22,8 @@ from odpipe.dynamics.propagator import propagate
 from odpipe.od.apriori import LineOfSight
 from odpipe.od.flyby_apriori import (approach_state, asymptote_search, distinct_sides, polish_approach, radial_distance,
                                      radial_los, sphere_grid)
+from odpipe.operations.schema import ConfigError
+from odpipe.pipeline.apriori import flyby_apriori
 from odpipe.pipeline.config import load_config
 from odpipe.pipeline.run import run_config
 from odpipe.pipeline.setup import force_model, tdb
@@ -162,3 +164,22 @@ def test_asymptote_search_recovers_a_synthetic_approach():
     found, v = min(polished, key=lambda a: np.sum((radial_los(los, t_p, MU_VENUS, a[0][None], a[1])[0] - y) ** 2))
     assert np.degrees(np.arccos(np.clip(found @ side, -1, 1))) < 1e-3
     assert v == pytest.approx(v_true, rel=1e-5)
+
+
+def _flyby_config(tmp_path, shared_data, edit):
+    text = (RUNS / "messenger_2007_06_04_doppler.toml").read_text()
+    text = re.sub(r'"\.\./\.\./shared/data/', f'"{shared_data}/', text)
+    (tmp_path / "arc.toml").write_text(edit(text))
+    return tmp_path / "arc.toml"
+
+
+@pytest.mark.realdata
+def test_flyby_apriori_errors_name_their_key(tmp_path, shared_data):
+    """A body the ephemeris lacks is named by its key when the a priori is computed; a second a priori at load."""
+    path = _flyby_config(tmp_path, shared_data, lambda t: t.replace('body = "venus"', 'body = "vulcan"'))
+    with pytest.raises(ConfigError, match=r"initial_state\.from_flyby\.body.*'vulcan' is not in de440"):
+        flyby_apriori(load_config(path))
+    path = _flyby_config(tmp_path, shared_data,
+                         lambda t: t.replace("[initial_state]\n", "[initial_state]\nstate = [1, 2, 3, 4, 5, 6]\n"))
+    with pytest.raises(ConfigError, match="give one of state, from_oem, from_doppler or from_flyby"):
+        load_config(path)
