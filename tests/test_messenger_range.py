@@ -110,3 +110,21 @@ def test_drvid_keeps_the_first_dss63_pass_and_rejects_the_others(data):
         removed |= ((rng["station_rx"] == w["station_rx"]) & (rng["epoch"] >= pd.Timestamp(w["start"]))
                     & (rng["epoch"] <= pd.Timestamp(w["end"]))).to_numpy()
     np.testing.assert_array_equal(removed, (rng["pass"] != 1).to_numpy())
+
+
+@pytest.mark.realdata
+def test_edit_windows_need_a_reason_and_an_order(tmp_path, shared_data):
+    import re
+
+    from odpipe.operations.schema import ConfigError
+    from odpipe.pipeline.config import load_config
+
+    text = re.sub(r'"\.\./\.\./shared/data/', f'"{shared_data}/', (RUNS / "messenger_2007_06_04.toml").read_text())
+    text = re.sub(r'^reason = ".*"$', 'reason = " "', text, count=1, flags=re.M)  # the first window's
+    text = text.replace('end = "2007-06-05T05:00:00"', 'end = "2007-06-04T19:00:00"', 1)
+    (tmp_path / "arc.toml").write_text(text)
+    with pytest.raises(ConfigError) as err:
+        load_config(tmp_path / "arc.toml")
+    msg = str(err.value)
+    assert "preprocess.edit_windows[0].reason" in msg and "say why the rows are removed" in msg
+    assert "preprocess.edit_windows[0].end" in msg and "before the start" in msg
