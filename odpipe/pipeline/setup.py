@@ -110,7 +110,8 @@ def station_catalog(cfg: RunConfig) -> StationCatalog:
 
 def initial_state(cfg: RunConfig) -> tuple[float, np.ndarray]:
     """The configured a priori epoch (TDB s) and state (m, m/s, ICRF about the dynamics centre): given, read
-    from an OEM at the epoch, or found in the arc's own Doppler (then at the first Doppler point used)."""
+    from an OEM at the epoch, or found in the arc's own Doppler, alone or with a flyby's epoch (then at the first
+    Doppler point used)."""
     init = cfg.initial_state
     if init.from_doppler is not None:
         from odpipe.pipeline.apriori import doppler_apriori  # it reads the data through this module
