@@ -68,7 +68,8 @@ class ArcSetup:
     "36 arcsec", "1.7e-4 rad" (:data:`ANGLE_UNITS`).
     angle_bias_sigma: one constant bias (rad) per receiving station and angle observable (None: none).
     range_bias_sigma: per pass and receiving station (m; None: no biases; pass_id -1 = one per station);
-    ``range_bias_per`` "station": one per station over the arc whatever the passes.
+    ``range_bias_per`` "station": one per station over the arc whatever the passes;
+    ``range_bias_stations``: only these receiving stations' ranges get biases (None: every station's).
     bias_apriori: a priori bias values (m; rad for angles) by "observable:station_rx" or "observable" (others 0).
     cd_sigma: a priori sigma of the drag coefficient (None: not estimated; a priori the model's Cd).
     polynomial_sigma: (c0 m/s^2, c1 m/s^3) a priori sigmas of every inertial polynomial acceleration's
@@ -106,6 +107,7 @@ class ArcSetup:
     data_sigma: dict = field(default_factory=lambda: dict(DATA_SIGMA))
     range_bias_sigma: float | None = 5.0
     range_bias_per: str = "pass"
+    range_bias_stations: tuple | None = None
     doppler_bias_sigma: float | None = None
     time_offset_sigma: float | None = None
     angle_bias_sigma: float | None = None
@@ -238,6 +240,8 @@ def build_registry(setup: ArcSetup, rows: pd.DataFrame) -> ParameterRegistry:
         sel = rows.loc[rows["observable"] == obs, ["station_rx", "pass_id"]]
         if obs == "range" and setup.range_bias_per == "station":
             sel = sel.assign(pass_id=-1)
+        if obs == "range" and setup.range_bias_stations is not None:
+            sel = sel[sel["station_rx"].isin(setup.range_bias_stations)]
         for st, pid in sel.drop_duplicates().itertuples(index=False):
             info = {"observable": obs, "station": st, "spacecraft": sc}
             if pid >= 0:
