@@ -203,6 +203,8 @@ class DragSection:
     atmosphere: Literal["harris_priester", "nrlmsise00"] = "harris_priester"  # density model (nrlmsise00 evaluated below 1500 km)
     space_weather: Path | None = checked(readable_files, default=None)  # nrlmsise00: F10.7/Ap, MSFC MSAFE table or CelesTrak CSSI file
     solar_activity_level: Literal["95%", "50%", "5%"] = "50%"  # the MSAFE table's percentile columns used
+    # nrlmsise00: its Ap history (3-hourly Ap of a CSSI file; an MSAFE table's Ap seven times) for the daily Ap
+    ap_history: bool = False
 
     def problems(self):
         if self.atmosphere == "nrlmsise00" and self.space_weather is None:

@@ -51,7 +51,7 @@ def force_model(cfg: RunConfig) -> F.ForceModel:
     if dyn.drag is not None:
         d = dyn.drag
         weather = open_space_weather(d.space_weather, d.solar_activity_level) if d.space_weather else None
-        comps.append(F.AtmosphericDrag(d.cd, d.area, d.n_bulge, d.atmosphere, weather))
+        comps.append(F.AtmosphericDrag(d.cd, d.area, d.n_bulge, d.atmosphere, weather, d.ap_history))
     if dyn.polynomial_acceleration is not None:
         poly = dyn.polynomial_acceleration
         t_ref = tdb(poly.epoch or cfg.initial_state.epoch or cfg.arc.start)
