@@ -59,15 +59,22 @@ def _tdb(utc: str) -> float:
 
 @pytest.mark.realdata
 def test_lageos2_kalman_run_matches_orekits_filter_and_smoother(tmp_path, shared_data):
-    """Measured 2026-11-26 (docs/validation.md, LAGEOS-2 sequential): the filter's last state 2.76 m and
-    0.90 mm/s from the reference, the smoothed first state 2.97 m and 1.05 mm/s, smoothed sigmas 12.28 m
-    and 6.12 mm/s; the filter's residuals min/max/mean/std -5.934/+3.046/+0.049/1.382 m; YARL's bias
-    -0.003 +- 0.866 m. Tolerances: Orekit's own, except the last position: Orekit's filter is within 2.47 m
-    of the reference and odpipe's is to be within 1 m of Orekit's (issue 22's LAGEOS-2 target), so odpipe's
-    must be within 2.47 + 1 m of the reference (it is 0.29 m beyond Orekit's 2.47, inside odpipe's 11.2 m
-    sigma); the residuals' spread within the chi-square bounds of a variance (99.9 %), their mean within
-    3.29 standard errors, each extreme within one residual's standard deviation; the state differences
-    and YARL's bias inside odpipe's covariance (99.9 %)."""
+    """Measured 2026-11-26 with Orekit's troposphere (modified Saastamoinen, its standard atmosphere) and
+    YARL's range bias alone, as Orekit's test: the filter's last state 2.74 m and 0.88 mm/s from the
+    reference, the smoothed first state 2.99 m and 1.07 mm/s, smoothed sigmas 12.24 m and 6.11 mm/s; the
+    filter's residuals min/max/mean/std -5.933/+3.032/+0.058/1.387 m; YARL's bias -0.007 +- 0.865 m.
+    Tolerances: Orekit's own, except the last position: Orekit's filter is within 2.47 m of the reference
+    and odpipe's is to be within 1 m of Orekit's (issue 22's LAGEOS-2 target), so odpipe's must be within
+    2.47 + 1 m of the reference. It is 0.27 m beyond Orekit's 2.47 (inside odpipe's 11.1 m sigma) and no
+    expressible difference closes that (switched one at a time, docs/validation.md): Saastamoinen-Niell
+    instead of Orekit's troposphere 2.70 m, biases on all four stations 2.79 m, both 2.76 m; an extended
+    filter relinearised after every range as Orekit's (odpipe.studies.ekf on this run's problem) matches
+    Orekit's residuals best (-5.924/+3.285/+0.067/1.449 m against Orekit's -5.911/+3.307/-0.037/1.454) but
+    ends 2.89 m from the reference. Not tried: YARL's estimated position offsets, Orekit's integrator
+    tolerance (10 m position error, in its filter and in its propagation of the reference). The residuals'
+    spread within the chi-square bounds of a variance (99.9 %), their mean within 3.29 standard errors,
+    each extreme within one residual's standard deviation; the state differences and YARL's bias inside
+    odpipe's covariance (99.9 %)."""
     path = _local_config(tmp_path, shared_data)
     assert main(["run", str(path), "--force"]) == 0
     cfg = load_config(path)
@@ -111,7 +118,9 @@ def test_lageos2_kalman_run_matches_orekits_filter_and_smoother(tmp_path, shared
     assert abs(after_update.min() - OREKIT_RANGE_STATS["min"]) < std
     assert abs(after_update.max() - OREKIT_RANGE_STATS["max"]) < std
 
-    # YARL's range bias within odpipe's sigma of Orekit's (the other stations' are odpipe's alone)
+    # YARL's range bias, the only one as Orekit's (estimation.range_bias_stations), within odpipe's sigma of Orekit's
+    names = products.parameters["name"]
+    assert names[names.str.startswith("bias.range.")].tolist() == ["bias.range.YARL.pass-1"]
     b = products.parameters.set_index("name").loc["bias.range.YARL.pass-1"]
     assert ((b["estimate"] - OREKIT_YARL_BIAS) / b["sigma"]) ** 2 < chi2.ppf(0.999, 1)
 
