@@ -82,6 +82,7 @@ class ArcSetup:
     oscillator_sigma: (y0, y1 1/s) sigmas of the one-way oscillator's fractional frequency offset and drift,
     when doppler_1way is fitted (a priori and reference epoch from ``measurements.oscillators``).
     station_sigma: considered (not estimated) error of each station's ITRS coordinates (m per axis).
+    station_position_sigma: {station: m per ITRS axis}: those stations' coordinate offsets estimated (a priori 0).
     media_sigma: considered error of the media calibration scale (fraction of ``media_m``).
     edit_k: innovation k-sigma per iteration (last repeats); reweight: ARTEMIS data reweighting.
     sigma_scale: data-weight stages (loose to tight; see :class:`FitOptions`).
@@ -116,6 +117,7 @@ class ArcSetup:
     polynomial_sigma: tuple | None = None
     oscillator_sigma: tuple | None = None
     station_sigma: float | None = None
+    station_position_sigma: dict = field(default_factory=dict)
     media_sigma: float | None = None
     edit_k: tuple = FitOptions.edit_k  # the fit's defaults have one home, FitOptions
     max_iter: int = FitOptions.max_iter
@@ -260,8 +262,12 @@ def build_registry(setup: ArcSetup, rows: pd.DataFrame) -> ParameterRegistry:
         y0, y1, _ = setup.measurements.oscillators[sc]
         reg.add(f"{sc}.osc_y0", "clock", y0, setup.oscillator_sigma[0], owner=sc, oscillator="y0")
         reg.add(f"{sc}.osc_y1", "clock", y1, setup.oscillator_sigma[1], owner=sc, oscillator="y1")
+    tracking = set(rows["station_rx"]) | set(rows["station_tx"]) - {""}
+    for st in sorted(tracking & set(setup.station_position_sigma)):
+        for axis in "xyz":
+            reg.add(f"station.{st}.{axis}", "station", 0.0, setup.station_position_sigma[st], owner=st, axis=axis)
     if setup.station_sigma is not None:
-        stations = sorted(set(rows["station_rx"]) | set(rows["station_tx"]) - {""})
+        stations = sorted(tracking - set(setup.station_position_sigma))
         for st in stations:
             for axis in "xyz":
                 reg.add(f"station.{st}.{axis}", "station", 0.0, setup.station_sigma, owner=st, consider=True,

@@ -346,6 +346,9 @@ class EstimationSection:
     range_bias_per: Literal["pass", "station"] = ArcSetup.range_bias_per
     # receiving stations whose ranges get biases, e.g. ["YARL"] (none: every station's)
     range_bias_stations: list[str] | None = None
+    # m per ITRS axis, a priori 0: stations whose coordinates are estimated, e.g. { YARL = 1.0 } (Orekit's
+    # estimated station offsets); stations without rows in the arc are left out
+    station_position_sigma: dict[str, float] = checked(positive, default_factory=dict)
     # m, a priori range bias by receiving station (the others 0), e.g. { Fucino = 13468.956 }
     range_bias_apriori: dict[str, float] = checked(finite, default_factory=dict)
     # a priori sigma of one constant bias per station and angle observable: rad, or with its unit ("0.5 deg")

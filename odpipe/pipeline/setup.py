@@ -160,6 +160,7 @@ def arc_setup(cfg: RunConfig, fm: F.ForceModel, ramps, catalog: StationCatalog) 
                     data_sigma=dict(est.data_sigma), range_bias_sigma=est.range_bias_sigma,
                     range_bias_per=est.range_bias_per, bias_apriori=bias_apriori(est),
                     range_bias_stations=None if est.range_bias_stations is None else tuple(est.range_bias_stations),
+                    station_position_sigma=dict(est.station_position_sigma),
                     angle_bias_sigma=None if est.angle_bias_sigma is None
                     else sigma_value("angle_", est.angle_bias_sigma),
                     cd_sigma=est.cd_sigma if cfg.dynamics.drag is not None else None,
