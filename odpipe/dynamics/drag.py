@@ -23,7 +23,9 @@ latitude phi_c + f sin(2 phi_c) from the ICRF latitude phi_c; longitude from the
 angle at UT1 = UTC (precession-nutation ignored, 0.15 deg in 2010: the model's longitude terms are
 smooth); UTC = TDB - (TT - UTC at the arc's start); local solar time UT + longitude/15 h. Solar and
 geomagnetic activity from :mod:`~odpipe.environment.atmosphere.space_weather` (MSAFE or CSSI),
-tabulated every 3 h over the arc at compile time and interpolated linearly.
+tabulated every 3 h over the arc at compile time and interpolated linearly. With ``ap_history`` the
+model takes its Ap history (switch 9 = -1) instead of the daily Ap: tabulated once per UT 3-hour
+interval (00, 03, ... 21 h UTC) and held over it, as the 3-hourly Ap it is made of.
 
 Partials for the STM: d a/d v, d a/d r (through v_r, the height and, Harris-Priester, the bulge
 angle; NRLMSISE-00: the height only, by a central difference of +-100 m) and d a/d Cd = a/Cd
@@ -55,13 +57,15 @@ SW_STEP = 10800.0  # s, space-weather tabulation step
 class AtmosphericDrag:
     """Drag coefficient Cd (estimable parameter 'cd'), cross-section area (m^2);
     Harris-Priester bulge exponent n (2 low, 6 polar orbits); atmosphere 'harris_priester' or
-    'nrlmsise00' (which needs space_weather). Earth-centred models only."""
+    'nrlmsise00' (which needs space_weather; ap_history: NRLMSISE-00 fed the Ap history of the
+    space weather instead of its daily Ap). Earth-centred models only."""
 
     cd: float
     area: float
     n_bulge: float = 6.0
     atmosphere: str = "harris_priester"
     space_weather: MonthlyForecast | DailyRecords | None = None
+    ap_history: bool = False
 
     def __post_init__(self):
         if self.atmosphere not in ATMOSPHERES:
@@ -72,9 +76,11 @@ class AtmosphericDrag:
 
 # on; msis (NRLMSISE-00, else Harris-Priester); Cd; area m^2; bulge exponent; env.pos row of the Sun;
 # d a/d p row of 'cd' (-1: not estimated); space weather: first epoch (TDB s), step (s), rows
-# (previous day's F10.7, 81-day mean, Ap); TDB of the UTC year's start; TT - UTC (s)
+# (previous day's F10.7, 81-day mean, Ap); TDB of the UTC year's start; TT - UTC (s); Ap history: TDB of
+# the first UT 3-hour interval's start, one row (7,) per interval (NaN: the daily Ap instead)
 DragData = namedtuple("DragData", ["on", "msis", "cd", "area", "n_bulge", "sun_slot", "cd_row", "sw_t0", "sw_step",
-                                   "sw", "t_year", "tt_utc"])
+                                   "sw", "t_year", "tt_utc", "aph_t0", "aph"])
+NO_HISTORY = np.full((1, 7), np.nan)
 
 # height (km), minimum and maximum density (kg/m^3): M&G Table 3.8 (g/km^3 * 1e-12)
 HP_TABLE = np.array([
@@ -154,7 +160,7 @@ def harris_priester(r, r_sun, n_bulge):
 
 
 @njit(cache=True)
-def nrlmsise_density(t, r, sw_t0, sw_step, sw, t_year, tt_utc):
+def nrlmsise_density(t, r, sw_t0, sw_step, sw, t_year, tt_utc, aph_t0, aph):
     """NRLMSISE-00 density (kg/m^3) at r (Earth-centred ICRF, m) and TDB t; and d rho / d r (3,)."""
     h, dh = height(r)
     grad = np.zeros(3)
@@ -177,8 +183,10 @@ def nrlmsise_density(t, r, sw_t0, sw_step, sw, t_year, tt_utc):
     x[5] = (1.0 - w) * sw[i, 1] + w * sw[i + 1, 1]
     x[6] = (1.0 - w) * sw[i, 0] + w * sw[i + 1, 0]
     x[7] = (1.0 - w) * sw[i, 2] + w * sw[i + 1, 2]
-    rho = mass_density(x, h / 1000.0)
-    drho_dh = (mass_density(x, (h + MSIS_DH) / 1000.0) - mass_density(x, (h - MSIS_DH) / 1000.0)) / (2.0 * MSIS_DH)
+    a = aph[min(max(int(np.floor((t - aph_t0) / SW_STEP)), 0), aph.shape[0] - 1)]
+    rho = mass_density(x, h / 1000.0, a)
+    up, down = mass_density(x, (h + MSIS_DH) / 1000.0, a), mass_density(x, (h - MSIS_DH) / 1000.0, a)
+    drho_dh = (up - down) / (2.0 * MSIS_DH)
     for j in range(3):
         grad[j] = drho_dh * dh[j]
     return rho, grad
@@ -221,14 +229,25 @@ def _space_weather_rows(d: AtmosphericDrag, lo: float, hi: float):
     return lo, SW_STEP, d.space_weather.nrlmsise_inputs(t), float(utc_to_tdb(year)), tt_utc
 
 
+def _ap_history_rows(d: AtmosphericDrag, lo: float, hi: float):
+    """TDB of the start of the UT 3-hour interval holding lo, and the Ap history of each interval to hi."""
+    if d.atmosphere != "nrlmsise00" or not d.ap_history:
+        return 0.0, NO_HISTORY
+    hours = tdb_to_utc(lo).astype("datetime64[h]").astype(np.int64)
+    t0 = float(utc_to_tdb(np.datetime64(int(hours - hours % 3), "h").astype("datetime64[ns]")))
+    n = int(np.ceil((hi - t0) / SW_STEP)) + 1
+    return t0, d.space_weather.ap_history(t0 + SW_STEP * (np.arange(n) + 0.5))
+
+
 def _compile(components, ctx) -> DragData:
     if not components:
-        return DragData(False, False, 0.0, 0.0, 0.0, -1, -1, 0.0, 1.0, np.zeros((2, 3)), 0.0, 0.0)
+        return DragData(False, False, 0.0, 0.0, 0.0, -1, -1, 0.0, 1.0, np.zeros((2, 3)), 0.0, 0.0, 0.0, NO_HISTORY)
     if ctx.center != "earth":
         raise ValueError("atmospheric drag needs an Earth-centred force model")
     d = components[0]
     return DragData(True, d.atmosphere == "nrlmsise00", float(d.cd), float(d.area), float(d.n_bulge), ctx.slot["sun"],
-                    int(ctx.rows(["cd"])[0]), *_space_weather_rows(d, ctx.lo, ctx.hi))
+                    int(ctx.rows(["cd"])[0]), *_space_weather_rows(d, ctx.lo, ctx.hi),
+                    *_ap_history_rows(d, ctx.lo, ctx.hi))
 
 
 @kernel(DragData)
@@ -236,7 +255,8 @@ def _kernel(data, t, r, v, env, acc, grad_r, grad_v, dadp):
     if not data.on:
         return
     if data.msis:
-        rho, drho = nrlmsise_density(t, r, data.sw_t0, data.sw_step, data.sw, data.t_year, data.tt_utc)
+        rho, drho = nrlmsise_density(t, r, data.sw_t0, data.sw_step, data.sw, data.t_year, data.tt_utc, data.aph_t0,
+                                     data.aph)
     else:
         rho, drho = harris_priester(r, env.pos[data.sun_slot], data.n_bulge)
     d_cd = np.zeros(3)

@@ -7,6 +7,9 @@ Sources, in order of preference, with the label each value carries:
   alone where no .TRO card covers a DSN time (``"DSN-seasonal (no TRO)"``);
   the Saastamoinen standard atmosphere at the site for non-DSN stations
   (``"standard-atmosphere"``); mapped to the elevation with Niell (1996).
+  With ``standard_troposphere="modified-saastamoinen"`` non-DSN stations get
+  Orekit's modified Saastamoinen slant delay on its standard atmosphere
+  instead (``"standard-atmosphere (modified Saastamoinen)"``).
 - ionosphere: TRK-2-23 .ION line-of-sight cards for the spacecraft — "the
   one-way ionospheric range delay to the spacecraft, in meters at a nominal
   S-band frequency of 2295 MHz", one normalized polynomial per pass from rise
@@ -21,18 +24,23 @@ from __future__ import annotations
 
 import numpy as np
 
-from odpipe.media import niell, saastamoinen
+from odpipe.media import modified_saastamoinen, niell, saastamoinen
 from odpipe.media.ionosphere import IonexModel, group_delay
 from odpipe.media.seasonal import dsn_seasonal
 from parsers.trk223 import CalibrationSet, complex_of
 
 F_S_BAND_HZ = 2295e6    # TRK-2-23 CHPART calibrations are range delays at S-band downlink (2295 MHz)
+STANDARD_TROPOSPHERES = ("saastamoinen-niell", "modified-saastamoinen")
 
 
 class MediaModel:
     """Troposphere and ionosphere leg delays from calibrations, maps or climatology."""
 
-    def __init__(self, calibrations: CalibrationSet | None = None, ionex: IonexModel | None = None):
+    def __init__(self, calibrations: CalibrationSet | None = None, ionex: IonexModel | None = None,
+                 standard_troposphere: str = "saastamoinen-niell"):
+        if standard_troposphere not in STANDARD_TROPOSPHERES:
+            raise ValueError(f"standard troposphere {standard_troposphere!r}: one of {STANDARD_TROPOSPHERES}")
+        self.standard_troposphere = standard_troposphere
         self.calibrations = calibrations or CalibrationSet([])
         self.seasonal = dsn_seasonal()
         self.ionex = ionex
@@ -52,6 +60,9 @@ class MediaModel:
                 zd[part] = self.seasonal.zenith_delay(station, t, part) + np.where(used >= 0, adj, 0.0)
                 label = np.where(used >= 0, used, label)
             return zd["dry"] * mh + zd["wet"] * mw, names[label]
+        if self.standard_troposphere == "modified-saastamoinen":
+            return (np.broadcast_to(modified_saastamoinen.standard_slant_delay(elevation, height_m), t.shape),
+                    np.full(t.shape, "standard-atmosphere (modified Saastamoinen)", dtype=object))
         dry, wet = saastamoinen.standard_zenith_delays(latitude, height_m)
         return dry * mh + wet * mw, np.full(t.shape, "standard-atmosphere", dtype=object)
 

@@ -33,13 +33,17 @@ def saturation_vapour_pressure(temperature_k):
     return 611.0 * 10.0 ** (7.5 * (t - 273.15) / (t - 35.85))
 
 
+def carried_up(p0_pa, t0_k, rh0, dh_m):
+    """(P Pa, T K, relative humidity) ``dh_m`` above a level where they are (p0, t0, rh0): the height
+    laws of Berg (1948) as given by Xu (2007), GPS - Theory, Algorithms and Applications, sec. 5.4."""
+    dh = np.asarray(dh_m, dtype=float)
+    return p0_pa * (1.0 - 2.26e-5 * dh) ** 5.225, t0_k - 0.0065 * dh, rh0 * np.exp(-6.396e-4 * dh)
+
+
 def standard_atmosphere(height_m):
-    """(P Pa, T K, e Pa) of the standard atmosphere at a height (Berg 1948 height laws, as in Xu 2007)."""
-    h = np.asarray(height_m, dtype=float)
-    p = P0_PA * (1.0 - 2.26e-5 * h) ** 5.225
-    t = T0_K - 0.0065 * h
-    e = RH0 * np.exp(-6.396e-4 * h) * saturation_vapour_pressure(t)
-    return p, t, e
+    """(P Pa, T K, e Pa) of the standard atmosphere at a height (1013.25 hPa, 18 degC, 50 % at 0 m)."""
+    p, t, rh = carried_up(P0_PA, T0_K, RH0, height_m)
+    return p, t, rh * saturation_vapour_pressure(t)
 
 
 def standard_zenith_delays(latitude, height_m):

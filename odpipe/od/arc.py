@@ -68,7 +68,8 @@ class ArcSetup:
     "36 arcsec", "1.7e-4 rad" (:data:`ANGLE_UNITS`).
     angle_bias_sigma: one constant bias (rad) per receiving station and angle observable (None: none).
     range_bias_sigma: per pass and receiving station (m; None: no biases; pass_id -1 = one per station);
-    ``range_bias_per`` "station": one per station over the arc whatever the passes.
+    ``range_bias_per`` "station": one per station over the arc whatever the passes;
+    ``range_bias_stations``: only these receiving stations' ranges get biases (None: every station's).
     bias_apriori: a priori bias values (m; rad for angles) by "observable:station_rx" or "observable" (others 0).
     cd_sigma: a priori sigma of the drag coefficient (None: not estimated; a priori the model's Cd).
     polynomial_sigma: (c0 m/s^2, c1 m/s^3) a priori sigmas of every inertial polynomial acceleration's
@@ -81,6 +82,7 @@ class ArcSetup:
     oscillator_sigma: (y0, y1 1/s) sigmas of the one-way oscillator's fractional frequency offset and drift,
     when doppler_1way is fitted (a priori and reference epoch from ``measurements.oscillators``).
     station_sigma: considered (not estimated) error of each station's ITRS coordinates (m per axis).
+    station_position_sigma: {station: m per ITRS axis}: those stations' coordinate offsets estimated (a priori 0).
     media_sigma: considered error of the media calibration scale (fraction of ``media_m``).
     edit_k: innovation k-sigma per iteration (last repeats); reweight: ARTEMIS data reweighting.
     sigma_scale: data-weight stages (loose to tight; see :class:`FitOptions`).
@@ -106,6 +108,7 @@ class ArcSetup:
     data_sigma: dict = field(default_factory=lambda: dict(DATA_SIGMA))
     range_bias_sigma: float | None = 5.0
     range_bias_per: str = "pass"
+    range_bias_stations: tuple | None = None
     doppler_bias_sigma: float | None = None
     time_offset_sigma: float | None = None
     angle_bias_sigma: float | None = None
@@ -114,6 +117,7 @@ class ArcSetup:
     polynomial_sigma: tuple | None = None
     oscillator_sigma: tuple | None = None
     station_sigma: float | None = None
+    station_position_sigma: dict = field(default_factory=dict)
     media_sigma: float | None = None
     edit_k: tuple = FitOptions.edit_k  # the fit's defaults have one home, FitOptions
     max_iter: int = FitOptions.max_iter
@@ -238,6 +242,8 @@ def build_registry(setup: ArcSetup, rows: pd.DataFrame) -> ParameterRegistry:
         sel = rows.loc[rows["observable"] == obs, ["station_rx", "pass_id"]]
         if obs == "range" and setup.range_bias_per == "station":
             sel = sel.assign(pass_id=-1)
+        if obs == "range" and setup.range_bias_stations is not None:
+            sel = sel[sel["station_rx"].isin(setup.range_bias_stations)]
         for st, pid in sel.drop_duplicates().itertuples(index=False):
             info = {"observable": obs, "station": st, "spacecraft": sc}
             if pid >= 0:
@@ -256,8 +262,12 @@ def build_registry(setup: ArcSetup, rows: pd.DataFrame) -> ParameterRegistry:
         y0, y1, _ = setup.measurements.oscillators[sc]
         reg.add(f"{sc}.osc_y0", "clock", y0, setup.oscillator_sigma[0], owner=sc, oscillator="y0")
         reg.add(f"{sc}.osc_y1", "clock", y1, setup.oscillator_sigma[1], owner=sc, oscillator="y1")
+    tracking = set(rows["station_rx"]) | set(rows["station_tx"]) - {""}
+    for st in sorted(tracking & set(setup.station_position_sigma)):
+        for axis in "xyz":
+            reg.add(f"station.{st}.{axis}", "station", 0.0, setup.station_position_sigma[st], owner=st, axis=axis)
     if setup.station_sigma is not None:
-        stations = sorted(set(rows["station_rx"]) | set(rows["station_tx"]) - {""})
+        stations = sorted(tracking - set(setup.station_position_sigma))
         for st in stations:
             for axis in "xyz":
                 reg.add(f"station.{st}.{axis}", "station", 0.0, setup.station_sigma, owner=st, consider=True,

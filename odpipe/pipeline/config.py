@@ -149,6 +149,9 @@ class CalibrationSection:
     # IONEX maps (TEC -> delay at each leg's frequency), where no .ION card covers
     ionex: list[Path] = checked(_files_of(lambda: ("parsers.ionex",), "IONEX"), default_factory=list)
     smoothing_order: int = checked(at_least(-1), default=10)  # per-pass polynomial; -1 = none
+    # radio troposphere of stations without calibrations (not DSN, not laser): Saastamoinen zenith delays of
+    # a standard atmosphere (18 degC) mapped with Niell, or Orekit's modified Saastamoinen on its own (20 degC)
+    standard_troposphere: Literal["saastamoinen-niell", "modified-saastamoinen"] = "saastamoinen-niell"
 
 
 @dataclass
@@ -219,6 +222,8 @@ class DragSection:
     atmosphere: Literal["harris_priester", "nrlmsise00"] = "harris_priester"  # density model (nrlmsise00 evaluated below 1500 km)
     space_weather: Path | None = checked(readable_files, default=None)  # nrlmsise00: F10.7/Ap, MSFC MSAFE table or CelesTrak CSSI file
     solar_activity_level: Literal["95%", "50%", "5%"] = "50%"  # the MSAFE table's percentile columns used
+    # nrlmsise00: its Ap history (3-hourly Ap of a CSSI file; an MSAFE table's Ap seven times) for the daily Ap
+    ap_history: bool = False
 
     def problems(self):
         if self.atmosphere == "nrlmsise00" and self.space_weather is None:
@@ -371,6 +376,11 @@ class EstimationSection:
     range_bias_sigma: float | None = checked(positive, default=ArcSetup.range_bias_sigma)
     # one range bias per pass and station, or one per station over the arc (SLR, Orekit's station biases)
     range_bias_per: Literal["pass", "station"] = ArcSetup.range_bias_per
+    # receiving stations whose ranges get biases, e.g. ["YARL"] (none: every station's)
+    range_bias_stations: list[str] | None = None
+    # m per ITRS axis, a priori 0: stations whose coordinates are estimated, e.g. { YARL = 1.0 } (Orekit's
+    # estimated station offsets); stations without rows in the arc are left out
+    station_position_sigma: dict[str, float] = checked(positive, default_factory=dict)
     # m, a priori range bias by receiving station (the others 0), e.g. { Fucino = 13468.956 }
     range_bias_apriori: dict[str, float] = checked(finite, default_factory=dict)
     # a priori sigma of one constant bias per station and angle observable: rad, or with its unit ("0.5 deg")

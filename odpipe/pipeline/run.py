@@ -117,7 +117,7 @@ def _run(cfg: RunConfig, attempt, log: RunLog, fingerprint: dict) -> dict:
     cal = cfg.calibration
     if cal.media:
         model = MediaModel(read_trk223(*cal.tro, *cal.ion) if (cal.tro or cal.ion) else None,
-                           IonexModel(read_ionex(*cal.ionex)) if cal.ionex else None)
+                           IonexModel(read_ionex(*cal.ionex)) if cal.ionex else None, cal.standard_troposphere)
 
         def media(rows, trajectory):
             return calibrate(rows, model, target_itrs=apparent_itrs(trajectory, fm.ephemeris), ramps=data.store,

@@ -51,7 +51,7 @@ def force_model(cfg: RunConfig) -> F.ForceModel:
     if dyn.drag is not None:
         d = dyn.drag
         weather = open_space_weather(d.space_weather, d.solar_activity_level) if d.space_weather else None
-        comps.append(F.AtmosphericDrag(d.cd, d.area, d.n_bulge, d.atmosphere, weather))
+        comps.append(F.AtmosphericDrag(d.cd, d.area, d.n_bulge, d.atmosphere, weather, d.ap_history))
     if dyn.polynomial_acceleration is not None:
         poly = dyn.polynomial_acceleration
         t_ref = tdb(poly.epoch or cfg.initial_state.epoch or cfg.arc.start)
@@ -164,6 +164,8 @@ def arc_setup(cfg: RunConfig, fm: F.ForceModel, ramps, catalog: StationCatalog) 
                     stochastic=stochastic, maneuvers=tuple(maneuver_plans(cfg, fm, state0, start)),
                     data_sigma=dict(est.data_sigma), range_bias_sigma=est.range_bias_sigma,
                     range_bias_per=est.range_bias_per, bias_apriori=bias_apriori(est),
+                    range_bias_stations=None if est.range_bias_stations is None else tuple(est.range_bias_stations),
+                    station_position_sigma=dict(est.station_position_sigma),
                     angle_bias_sigma=None if est.angle_bias_sigma is None
                     else sigma_value("angle_", est.angle_bias_sigma),
                     cd_sigma=est.cd_sigma if cfg.dynamics.drag is not None else None,

@@ -63,6 +63,8 @@ ZMIX = 62.5  # km, bottom of the transition to full mixing
 ALPHA = np.array([-0.38, 0.0, 0.0, 0.0, 0.17, 0.0, -0.38, 0.0, 0.0])  # thermal diffusion, by species slot
 ALTL = np.array([200.0, 300.0, 160.0, 250.0, 240.0, 450.0, 320.0, 450.0])  # km, top of the mixing correction
 SW_ON = np.ones(24)  # every switch on, daily Ap
+SW_HISTORY = SW_ON.copy()
+SW_HISTORY[9] = -1.0  # every switch on, the Ap history instead of the daily Ap
 
 
 @njit(cache=True)
@@ -617,10 +619,11 @@ def gtd7(doy, sec, alt_km, lat_deg, lon_deg, lst_h, f107a, f107, ap, ap_history=
 
 
 @njit(cache=True)
-def mass_density(x, alt_km):
+def mass_density(x, alt_km, aph):
     """Total mass density (kg/m^3) including anomalous oxygen (the model's GTD7D, the one for drag),
     all switches on; x = [doy, UT s, lat deg, lon deg, local solar time h, F10.7 81-day mean,
-    previous day's F10.7, daily Ap]."""
-    d = _gtd7(x, alt_km, np.zeros(7), SW_ON, SW_ON)[0]
+    previous day's F10.7, daily Ap]; with an Ap history aph (7,) (switch 9 = -1) unless aph[0] is NaN."""
+    sw = SW_ON if np.isnan(aph[0]) else SW_HISTORY
+    d = _gtd7(x, alt_km, aph, sw, sw)[0]
     return AMU * (4.0 * d[0] + 16.0 * (d[1] + d[8]) + 28.0 * d[2] + 32.0 * d[3] + 40.0 * d[4] + d[6]
                   + 14.0 * d[7]) * 1.0e3
