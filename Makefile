@@ -11,6 +11,7 @@ $(STAMP): pyproject.toml
 	$(BIN)/python -m pip install --quiet --upgrade pip
 	$(BIN)/python -m pip install --quiet -e '.[test]'
 	$(BIN)/python -m odpipe.pipeline.warmup  # numba's on-disk cache, filled once per checkout
+	$(BIN)/python -m tests.estimation_cases  # and the kernels of the tests' own estimation cases
 	touch $(STAMP)
 
 demo: $(STAMP)

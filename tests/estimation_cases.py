@@ -335,3 +335,13 @@ def twobody_case(rng, days=1.0, dt_obs=120.0, batch=8 * 3600.0, sig_acc=5e-9, ta
     obs = Observations(t, z, sigma, np.array([f"dss{s}.{'range' if k == 0 else 'rate'}"
                                               for s, k in zip(st, kind)]))
     return problem, obs, {"x0": truth_vec, "acc": acc, "states": X, "t_grid": t_grid}
+
+
+def compile_kernels() -> None:
+    """Compile this module's numba kernels into the checkout's cache (``make``'s install runs
+    ``python -m tests.estimation_cases``), so that the tests load them instead of compiling."""
+    flow(np.array([2.0e7, 0.0, 0.0, 0.0, 4.5e3, 0.0]), np.zeros(3), 0.0, np.array([60.0]), 30.0)
+
+
+if __name__ == "__main__":
+    compile_kernels()

@@ -4,8 +4,11 @@ Every numba kernel is cached on disk (``cache=True``), but a fresh checkout's ca
 empty, and the first demo would wait for the compiler. This runs the demo on the first
 ``DAYS`` days of its case in a temporary folder, with one worker: the same simulation,
 readers, force models, fits, products and report on less data, so every kernel signature
-the demo uses is compiled once into the checkout's cache. It prints the demo's own
-compile line (functions and seconds, main process and worker) and the warm-up's wall time.
+the demo uses is compiled once into the checkout's cache. Then it compiles the signatures
+the demo does not reach (:func:`other_kernels`: fixed-step RK4, the CRTBP right-hand side
+called directly, NRLMSISE-00 called directly), which studies and the tests use. It prints
+the demo's own compile line (functions and seconds, main process and worker), the other
+kernels' and the warm-up's wall time.
 """
 
 from __future__ import annotations
@@ -15,19 +18,40 @@ import tempfile
 import time
 from pathlib import Path
 
+import numpy as np
+
+from odpipe.dynamics.compile_timer import compile_timer
+from odpipe.dynamics.crtbp import crtbp_rhs
+from odpipe.dynamics.forces import ForceModel
+from odpipe.dynamics.propagator import propagate
+from odpipe.environment.atmosphere.nrlmsise00 import gtd7
 from odpipe.pipeline.demo import run_demo
 
 DAYS = 11.0  # two station-keeping maneuvers (days 3.5 and 10.5) and an attitude burn: short and long arcs
+GM_EARTH = 3.986004415e14  # m^3/s^2
+
+
+def other_kernels() -> None:
+    """One call of each kernel signature outside the demo: RK4 through the compiled force model
+    (one type for every model), ``crtbp_rhs`` on writable arrays (``studies.crtbp_orbits``) and
+    ``gtd7`` on writable arrays (drag and direct calls differ in array mutability)."""
+    x0 = np.array([7.0e6, 0.0, 0.0, 0.0, 7.5e3, 0.0])
+    propagate(x0, 0.0, 120.0, ForceModel("earth", central_gm=GM_EARTH), with_stm=True, method="rk4", max_step=60.0)
+    crtbp_rhs(0.0, np.array([0.82, 0.0, 0.1, 0.0, 0.2, 0.0]), np.array([0.0121]), np.empty(6))
+    gtd7(172, 29000.0, 400.0, 60.0, -70.0, 16.0, 150.0, 150.0, 4.0)
 
 
 def warm_up(days: float = DAYS) -> str:
-    """Run the shortened demo in a temporary folder; one line on what was compiled."""
+    """Run the shortened demo in a temporary folder, then :func:`other_kernels`; one line on what was compiled."""
     t0 = time.perf_counter()
     lines: list[str] = []
     with tempfile.TemporaryDirectory(prefix="odpipe-warmup-") as tmp:
         run_demo(Path(tmp) / "demo", workers=1, progress=lines.append, days=days)
     note = next((line for line in lines if line.startswith("numba:")), "numba: no compile report")
-    return f"warm-up on {days:g} days of the demo case, {time.perf_counter() - t0:.1f} s: {note}"
+    with compile_timer() as ct:
+        other_kernels()
+    return (f"warm-up on {days:g} days of the demo case, {time.perf_counter() - t0:.1f} s: {note}; "
+            f"kernels outside the demo: {ct.functions} functions in {ct.seconds:.1f} s")
 
 
 if __name__ == "__main__":
