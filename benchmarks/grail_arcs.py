@@ -54,16 +54,17 @@ def set_key(text: str, section: str, key: str, value: str) -> str:
     return "\n".join(lines) + "\n"
 
 
-def variant_config(name: str, out: Path, overrides: dict, source_out: Path | None) -> Path:
+def variant_config(name: str, out: Path, overrides: dict, source_out: Path | None, source=SOURCE) -> Path:
     """Write arc ``name``'s configuration for a variant into ``out/configs``: output in ``out``, the
-    a priori from ``source_out``'s run of the source arc, ``overrides`` {"section.key": TOML literal}."""
+    a priori from ``source_out``'s run of the source arc (``source[name]``), ``overrides`` {"section.key":
+    TOML literal}."""
     text = _absolute_paths((RUNS / f"{name}.toml").read_text(), RUNS)
     text = set_key(text, "run", "output", f'"{out}"')
     text = set_key(text, "products", "plots", "false")
     text = set_key(text, "products", "spk", "false")
     if source_out is not None:
         text = set_key(text, "initial_state", "from_oem",
-                       f'"{source_out / SOURCE[name] / "current" / "trajectory.oem"}"')
+                       f'"{source_out / source[name] / "current" / "trajectory.oem"}"')
     for dotted, value in overrides.items():
         section, key = dotted.rsplit(".", 1)
         text = set_key(text, section, key, value)
@@ -73,18 +74,19 @@ def variant_config(name: str, out: Path, overrides: dict, source_out: Path | Non
     return path
 
 
-def run_variant(out: Path, overrides: dict, start_out: Path, arcs=ORDER, log=print) -> dict:
-    """Run the daily ``arcs`` (chain order) of one variant; {arc: run_config summary or the error text}."""
+def run_variant(out: Path, overrides: dict, start_out: Path, arcs=ORDER, log=print, source=SOURCE) -> dict:
+    """Run the ``arcs`` (chain order) of one variant, each from its ``source`` arc's run; {arc: run_config
+    summary or the error text}."""
     results = {}
     for name in arcs:
-        src = start_out if SOURCE[name] == START else out
-        if SOURCE[name] != START and not isinstance(results.get(SOURCE[name], {}), dict):
-            results[name] = f"source {SOURCE[name]} failed"
+        src = start_out if source[name] == START else out
+        if source[name] != START and not isinstance(results.get(source[name], {}), dict):
+            results[name] = f"source {source[name]} failed"
             continue
         if (out / name / "current" / "summary.json").exists():
             results[name] = {"status": "present"}
             continue
-        cfg = variant_config(name, out, overrides, src)
+        cfg = variant_config(name, out, overrides, src, source)
         try:
             results[name] = run_config(cfg, progress=None)
             log(f"{out.name} {name}: {results[name]['status']}")
