@@ -2,14 +2,16 @@
 
 Needs ``benchmarks/grail_loo.py --only base`` first (the nightly chain in ``OUT/base``). Then:
 
-* ``multiarc``: the four daily arcs refitted as one multi-arc solution sharing the SRP scale
-  (:mod:`odpipe.pipeline.multiarc`, its configuration written to ``OUT/multiarc/multiarc.toml``);
+* ``multiarc``: the daily arcs (``--arcs``, default all four) refitted as one multi-arc solution sharing the
+  SRP scale (:mod:`odpipe.pipeline.multiarc`, its configuration written to ``OUT/multiarc_<days>/multiarc.toml``;
+  overlaps with the arcs not refitted are against the nightly's);
 * ``twoday``: ``runs/grail_b_2day_2012_04_09.toml``, 04-09 and 04-10 fitted as one arc from the start-up fit.
 
 Per solution: each arc's per-station two-way RMS (mm/s) and the overlaps (3D and R/I/C RMS, m) with the
 daily arcs, beside the nightly's. Written to ``OUT/multiarc_figures.csv``.
 
     nice .venv/bin/python benchmarks/grail_multiarc.py [--out out/grail_loo] [--only multiarc,twoday]
+        [--arcs grail_b_2012_04_10,grail_b_2012_04_11]
 """
 
 from __future__ import annotations
@@ -43,22 +45,25 @@ def overlap(a: Path, b: Path, label: str) -> dict:
             "intrack": s["pos_intrack_rms"], "crosstrack": s["pos_crosstrack_rms"], "hours": s["hours"]}
 
 
-def multiarc(out: Path, shared=("srp_scale",)) -> list[dict]:
-    folder = out / "multiarc"
+def multiarc(out: Path, arcs=DAILY, shared=("srp_scale",)) -> list[dict]:
+    folder = out / ("multiarc_" + "_".join(a[-2:] for a in arcs))
     folder.mkdir(parents=True, exist_ok=True)
     cfg = folder / "multiarc.toml"
-    arcs = ", ".join(f'"{out / "base" / "configs" / f"{a}.toml"}"' for a in DAILY)
+    names = arcs
+    arcs = ", ".join(f'"{out / "base" / "configs" / f"{a}.toml"}"' for a in names)
     cfg.write_text(f'[multiarc]\nname = "runs"\noutput = "{folder}"\narcs = [{arcs}]\n'
                    f'shared = [{", ".join(repr(s).replace(chr(39), chr(34)) for s in shared)}]\nrounds = 1\n')
-    done = all((folder / "runs" / a / "trajectory.oem").exists() for a in DAILY)
+    done = all((folder / "runs" / a / "trajectory.oem").exists() for a in names)
     if not done:
         result = run_multiarc(cfg)
         print(result["shared"].to_string(index=False), flush=True)
-    rows = [{"solution": "multiarc", "arc": a, **station_rms(folder / "runs" / a / "residuals.parquet")}
-            for a in DAILY]
+    label = folder.name
+    rows = [{"solution": label, "arc": a, **station_rms(folder / "runs" / a / "residuals.parquet")} for a in names]
+    oem = {a: out / "base" / a / "current" / "trajectory.oem" for a in DAILY}   # the nightly's, where not refitted
+    oem.update({a: folder / "runs" / a / "trajectory.oem" for a in names})
     for a, b in zip(DAILY[:-1], DAILY[1:]):
-        rows.append({"solution": "multiarc", **overlap(folder / "runs" / a / "trajectory.oem",
-                                                       folder / "runs" / b / "trajectory.oem", f"{a[-5:]} - {b[-5:]}")})
+        if a in names or b in names:
+            rows.append({"solution": label, **overlap(oem[a], oem[b], f"{a[-5:]} - {b[-5:]}")})
     return rows
 
 
@@ -87,11 +92,12 @@ def main(argv=None):
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--out", type=Path, default=Path("out/grail_loo"))
     ap.add_argument("--only", default="multiarc,twoday")
+    ap.add_argument("--arcs", default=",".join(DAILY), help="daily arcs of the multi-arc solution")
     args = ap.parse_args(argv)
     out = args.out.resolve()
     rows = nightly(out)
     for name in args.only.split(","):
-        rows += {"multiarc": multiarc, "twoday": twoday}[name](out)
+        rows += multiarc(out, tuple(args.arcs.split(","))) if name == "multiarc" else twoday(out)
     table = pd.DataFrame(rows)
     table.to_csv(out / "multiarc_figures.csv", index=False)
     with pd.option_context("display.width", 250, "display.max_columns", 40):

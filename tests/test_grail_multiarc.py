@@ -98,3 +98,17 @@ def test_fixing_part_of_a_polynomial_acceleration_is_refused():
         with_shared(setup, ("poly[0].x0",), (1e-10,), fixed=True)
     fixed = with_shared(setup, ("srp_scale",), (0.9,), fixed=True)
     assert fixed.srp_scale_sigma is None and fixed.polynomial_sigma == (1e-9, 1e-14)
+
+
+def test_a_multiarc_config_names_what_is_wrong(tmp_path):
+    from odpipe.operations.schema import ConfigError
+    from odpipe.pipeline.multiarc import load_multiarc
+
+    cfg = tmp_path / "m.toml"
+    cfg.write_text('[multiarc]\nname = "m"\narcs = ["a.toml"]\nshared = ["srp_scale", "mass"]\n')
+    with pytest.raises(ConfigError) as err:
+        load_multiarc(cfg)
+    assert "multiarc.arcs" in str(err.value) and "multiarc.shared[1]" in str(err.value)
+    cfg.write_text('[multiarc]\nname = "m"\narcs = ["a.toml", "b.toml"]\nshared = ["srp_scale"]\nrounds = 2\n')
+    sec = load_multiarc(cfg)
+    assert sec.arcs == [tmp_path / "a.toml", tmp_path / "b.toml"] and sec.rounds == 2

@@ -10,7 +10,9 @@ counts the prior once::
     P = (S0^-1 + sum L_i)^-1,   g = P (S0^-1 g0 + sum e_i)
 
 Then every arc is fitted again with the shared parameters fixed at ``g`` (its state, stochastic accelerations
-and biases conditioned on them: the multi-arc solution's local part). With ``rounds`` > 1 the arcs are
+and biases conditioned on them: the multi-arc solution's local part); its state covariances get the shared
+parameters' share, ``K P K^T`` with ``K = P_xg P_gg^-1`` the slope of the state with them in the arc's own fit
+(the conditional covariance alone is too small by that: the combination's error moves every arc). With ``rounds`` > 1 the arcs are
 fitted again about ``g`` (prior ``N(g, S0)``, counted out as above) until ``g`` moves by less than ``tol`` of
 its sigma. Each arc's consistency with the others: ``d_i = g_i - g`` with ``g_i`` the arc's own estimate
 with the common prior, ``(S0^-1 + L_i)^-1 (S0^-1 g0 + e_i)``, tested as chi-square with the covariance of a
@@ -45,12 +47,14 @@ def _field(name: str) -> str:
 @dataclass(frozen=True)
 class ArcShare:
     """What one arc's fit says about the shared parameters: its smoothed epoch estimate and covariance
-    (prior included) and the prior it was fitted with (mean, sigma)."""
+    (prior included), the prior it was fitted with (mean, sigma) and ``gain`` (K, 6, n): the slope of the
+    smoothed state at each grid epoch with the shared parameters, ``P_xg P_gg^-1`` (None: not known)."""
 
     estimate: np.ndarray
     covariance: np.ndarray
     prior_mean: np.ndarray
     prior_sigma: np.ndarray
+    gain: np.ndarray | None = None
 
     def information(self) -> tuple[np.ndarray, np.ndarray]:
         """(L, e): the data's information matrix and vector about the shared parameters (prior counted out)."""
@@ -68,8 +72,11 @@ def solution_share(sol, spacecraft: str, shared, prior_mean, prior_sigma) -> Arc
     if missing:
         raise KeyError(f"shared parameter(s) {missing} not estimated in the arc of {spacecraft} (set their sigma)")
     idx = [names.index(f"{spacecraft}.{n}") for n in shared]
-    return ArcShare(np.asarray(sol.smoothed_x[0][idx], float), sol.smoothed_P[0][np.ix_(idx, idx)],
-                    np.asarray(prior_mean, float), np.asarray(prior_sigma, float))
+    st = [names.index(f"{spacecraft}.{a}") for a in ("x", "y", "z", "vx", "vy", "vz")]
+    P = np.asarray(sol.smoothed_P)
+    gain = P[:, st][:, :, idx] @ np.linalg.inv(P[:, idx][:, :, idx])
+    return ArcShare(np.asarray(sol.smoothed_x[0][idx], float), P[0][np.ix_(idx, idx)],
+                    np.asarray(prior_mean, float), np.asarray(prior_sigma, float), gain)
 
 
 def share_of(arc: ArcSolution, shared) -> ArcShare:
@@ -148,8 +155,9 @@ def with_shared(setup: ArcSetup, names, values, fixed: bool) -> ArcSetup:
 
 @dataclass
 class MultiArcSolution:
-    """``arcs``: each arc fitted with the shared parameters fixed at ``shared.estimate``; ``shared``: the
-    combination (last round); ``rounds``: the combination of each round."""
+    """``arcs``: each arc fitted with the shared parameters fixed at ``shared.estimate`` (its ``covariances``
+    with the shared parameters' share added); ``shared``: the combination (last round); ``rounds``: the
+    combination of each round."""
 
     arcs: list
     shared: Combined
@@ -196,6 +204,13 @@ def fit_multiarc(arcs, shared, rounds: int = 1, tol: float = 0.1, first=None, lo
             break
     fitted = []
     for k, (table, setup) in enumerate(arcs):
-        fitted.append(fit_arc(table, with_shared(setup, shared, g, fixed=True)))
+        arc = fit_arc(table, with_shared(setup, shared, g, fixed=True))
+        K = shares[k].gain
+        if K is not None:
+            if K.shape[0] != arc.covariances.shape[0]:
+                raise ValueError(f"arc {k + 1}: its own fit has {K.shape[0]} grid epochs, the refit "
+                                 f"{arc.covariances.shape[0]} (the same set-up must give the same grid)")
+            arc.covariances = arc.covariances + K @ combos[-1].covariance @ K.transpose(0, 2, 1)
+        fitted.append(arc)
         log(f"multi-arc: arc {k + 1} of {len(arcs)} fitted with the shared parameters fixed")
     return MultiArcSolution(fitted, combos[-1], combos)
