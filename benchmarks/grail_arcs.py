@@ -104,13 +104,20 @@ def run_start(out: Path) -> Path:
 
 
 def arc_figures(out: Path, name: str) -> dict:
-    """Post-fit RMS per station (mm/s), rows fitted and edited by the fit, of one arc's current run."""
+    """Post-fit RMS per station (mm/s), rows fitted and edited by the fit, of one arc's current run: two-way
+    Doppler (``rms_mm_s.<station>``, ``fitted``, ``edited``) and, when fitted, one-way (``rms1w_mm_s.<station>``,
+    ``fitted_1way``, ``edited_1way``)."""
     run = out / name / "current"
     res = pd.read_parquet(run / "residuals.parquet")
-    ok = (res["status"] == "") & (res["observable"] == "doppler_2way")
-    row = {"arc": name, "fitted": int((ok & (res["flags"] == 0)).sum()), "edited": int((ok & (res["flags"] != 0)).sum())}
-    for st, g in res[ok & (res["flags"] == 0)].groupby("station_rx"):
-        row[f"rms_mm_s.{st}"] = float(np.sqrt(np.mean(g["postfit_los"] ** 2)) * 1e3)
+    row = {"arc": name}
+    for obs, suffix, key in (("doppler_2way", "", "rms_mm_s"), ("doppler_1way", "_1way", "rms1w_mm_s")):
+        ok = (res["status"] == "") & (res["observable"] == obs)
+        if obs == "doppler_1way" and not ok.any():
+            continue
+        row[f"fitted{suffix}"] = int((ok & (res["flags"] == 0)).sum())
+        row[f"edited{suffix}"] = int((ok & (res["flags"] != 0)).sum())
+        for st, g in res[ok & (res["flags"] == 0)].groupby("station_rx"):
+            row[f"{key}.{st}"] = float(np.sqrt(np.mean(g["postfit_los"] ** 2)) * 1e3)
     return row
 
 

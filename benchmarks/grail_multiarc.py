@@ -72,17 +72,20 @@ def twoday(out: Path) -> list[dict]:
     mine = out / "twoday" / TWO_DAY / "current"
     rows = [{"solution": "twoday", "arc": TWO_DAY, **station_rms(mine / "residuals.parquet")}]
     for other in ("grail_b_2012_04_08", "grail_b_2012_04_11"):
-        rows.append({"solution": "twoday", **overlap(mine / "trajectory.oem",
+        if (out / "base" / other / "current" / "trajectory.oem").exists():
+            rows.append({"solution": "twoday", **overlap(mine / "trajectory.oem",
                                                      out / "base" / other / "current" / "trajectory.oem",
                                                      f"2day - {other[-5:]}")})
     return rows
 
 
 def nightly(out: Path) -> list[dict]:
+    done = [a for a in DAILY if (out / "base" / a / "current" / "trajectory.oem").exists()]
     rows = [{"solution": "nightly", "arc": a, **station_rms(out / "base" / a / "current" / "residuals.parquet")}
-            for a in DAILY]
+            for a in done]
     for a, b in zip(DAILY[:-1], DAILY[1:]):
-        rows.append({"solution": "nightly", **overlap(out / "base" / a / "current" / "trajectory.oem",
+        if a in done and b in done:
+            rows.append({"solution": "nightly", **overlap(out / "base" / a / "current" / "trajectory.oem",
                                                       out / "base" / b / "current" / "trajectory.oem",
                                                       f"{a[-5:]} - {b[-5:]}")})
     return rows
