@@ -5,7 +5,8 @@ Needs ``benchmarks/grail_loo.py --only base`` first (the nightly chain in ``OUT/
 * ``multiarc``: the daily arcs (``--arcs``, default all four) refitted as one multi-arc solution sharing the
   SRP scale (:mod:`odpipe.pipeline.multiarc`, its configuration written to ``OUT/multiarc_<days>/multiarc.toml``;
   overlaps with the arcs not refitted are against the nightly's);
-* ``twoday``: ``runs/grail_b_2day_2012_04_09.toml``, 04-09 and 04-10 fitted as one arc from the start-up fit.
+* ``twoday``: ``runs/grail_b_2day_2012_04_09.toml`` (04-09 and 04-10 as one arc, from the start-up fit) and
+  ``runs/grail_b_2day_2012_04_08.toml`` (04-08 and 04-09, from the nightly's 04-09, as the daily 04-08).
 
 Per solution: each arc's per-station two-way RMS (mm/s) and the overlaps (3D and R/I/C RMS, m) with the
 daily arcs, beside the nightly's. Written to ``OUT/multiarc_figures.csv``.
@@ -27,6 +28,9 @@ from odpipe.analysis.overlap import compare, oem_trajectory
 from odpipe.pipeline.multiarc import run_multiarc
 
 TWO_DAY = "grail_b_2day_2012_04_09"
+# two-day arc -> (the arc whose solution gives its a priori, the daily arcs it overlaps)
+TWO_DAYS = {TWO_DAY: (START, ("grail_b_2012_04_08", "grail_b_2012_04_11")),
+            "grail_b_2day_2012_04_08": ("grail_b_2012_04_09", ("grail_b_2012_04_10",))}
 
 
 def station_rms(residuals: Path) -> dict:
@@ -67,15 +71,21 @@ def multiarc(out: Path, arcs=DAILY, shared=("srp_scale",)) -> list[dict]:
     return rows
 
 
-def twoday(out: Path) -> list[dict]:
-    run_variant(out / "twoday", {}, out / "start", arcs=(TWO_DAY,), source={TWO_DAY: START})
-    mine = out / "twoday" / TWO_DAY / "current"
-    rows = [{"solution": "twoday", "arc": TWO_DAY, **station_rms(mine / "residuals.parquet")}]
-    for other in ("grail_b_2012_04_08", "grail_b_2012_04_11"):
+def twoday(out: Path, name: str = TWO_DAY) -> list[dict]:
+    """One two-day arc (``TWO_DAYS[name]``: its source arc and the daily arcs it overlaps), from the nightly's
+    run of its source (or the start-up fit)."""
+    source, others = TWO_DAYS[name]
+    if source != START and not (out / "twoday" / source).exists():
+        (out / "twoday").mkdir(parents=True, exist_ok=True)
+        (out / "twoday" / source).symlink_to(out / "base" / source)
+    run_variant(out / "twoday", {}, out / "start", arcs=(name,), source={name: source})
+    mine = out / "twoday" / name / "current"
+    rows = [{"solution": "twoday", "arc": name, **station_rms(mine / "residuals.parquet")}]
+    for other in others:
         if (out / "base" / other / "current" / "trajectory.oem").exists():
             rows.append({"solution": "twoday", **overlap(mine / "trajectory.oem",
                                                      out / "base" / other / "current" / "trajectory.oem",
-                                                     f"2day - {other[-5:]}")})
+                                                     f"{name[-10:]} - {other[-5:]}")})
     return rows
 
 
@@ -100,7 +110,10 @@ def main(argv=None):
     out = args.out.resolve()
     rows = nightly(out)
     for name in args.only.split(","):
-        rows += multiarc(out, tuple(args.arcs.split(","))) if name == "multiarc" else twoday(out)
+        if name == "multiarc":
+            rows += multiarc(out, tuple(args.arcs.split(",")))
+        else:
+            rows += [r for two in TWO_DAYS for r in twoday(out, two)]
     table = pd.DataFrame(rows)
     table.to_csv(out / "multiarc_figures.csv", index=False)
     with pd.option_context("display.width", 250, "display.max_columns", 40):
