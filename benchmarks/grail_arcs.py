@@ -54,16 +54,17 @@ def set_key(text: str, section: str, key: str, value: str) -> str:
     return "\n".join(lines) + "\n"
 
 
-def variant_config(name: str, out: Path, overrides: dict, source_out: Path | None) -> Path:
+def variant_config(name: str, out: Path, overrides: dict, source_out: Path | None, source=SOURCE) -> Path:
     """Write arc ``name``'s configuration for a variant into ``out/configs``: output in ``out``, the
-    a priori from ``source_out``'s run of the source arc, ``overrides`` {"section.key": TOML literal}."""
+    a priori from ``source_out``'s run of the source arc (``source[name]``), ``overrides`` {"section.key":
+    TOML literal}."""
     text = _absolute_paths((RUNS / f"{name}.toml").read_text(), RUNS)
     text = set_key(text, "run", "output", f'"{out}"')
     text = set_key(text, "products", "plots", "false")
     text = set_key(text, "products", "spk", "false")
     if source_out is not None:
         text = set_key(text, "initial_state", "from_oem",
-                       f'"{source_out / SOURCE[name] / "current" / "trajectory.oem"}"')
+                       f'"{source_out / source[name] / "current" / "trajectory.oem"}"')
     for dotted, value in overrides.items():
         section, key = dotted.rsplit(".", 1)
         text = set_key(text, section, key, value)
@@ -73,18 +74,19 @@ def variant_config(name: str, out: Path, overrides: dict, source_out: Path | Non
     return path
 
 
-def run_variant(out: Path, overrides: dict, start_out: Path, arcs=ORDER, log=print) -> dict:
-    """Run the daily ``arcs`` (chain order) of one variant; {arc: run_config summary or the error text}."""
+def run_variant(out: Path, overrides: dict, start_out: Path, arcs=ORDER, log=print, source=SOURCE) -> dict:
+    """Run the ``arcs`` (chain order) of one variant, each from its ``source`` arc's run; {arc: run_config
+    summary or the error text}."""
     results = {}
     for name in arcs:
-        src = start_out if SOURCE[name] == START else out
-        if SOURCE[name] != START and not isinstance(results.get(SOURCE[name], {}), dict):
-            results[name] = f"source {SOURCE[name]} failed"
+        src = start_out if source[name] == START else out
+        if source[name] != START and not isinstance(results.get(source[name], {}), dict):
+            results[name] = f"source {source[name]} failed"
             continue
         if (out / name / "current" / "summary.json").exists():
             results[name] = {"status": "present"}
             continue
-        cfg = variant_config(name, out, overrides, src)
+        cfg = variant_config(name, out, overrides, src, source)
         try:
             results[name] = run_config(cfg, progress=None)
             log(f"{out.name} {name}: {results[name]['status']}")
@@ -102,13 +104,20 @@ def run_start(out: Path) -> Path:
 
 
 def arc_figures(out: Path, name: str) -> dict:
-    """Post-fit RMS per station (mm/s), rows fitted and edited by the fit, of one arc's current run."""
+    """Post-fit RMS per station (mm/s), rows fitted and edited by the fit, of one arc's current run: two-way
+    Doppler (``rms_mm_s.<station>``, ``fitted``, ``edited``) and, when fitted, one-way (``rms1w_mm_s.<station>``,
+    ``fitted_1way``, ``edited_1way``)."""
     run = out / name / "current"
     res = pd.read_parquet(run / "residuals.parquet")
-    ok = (res["status"] == "") & (res["observable"] == "doppler_2way")
-    row = {"arc": name, "fitted": int((ok & (res["flags"] == 0)).sum()), "edited": int((ok & (res["flags"] != 0)).sum())}
-    for st, g in res[ok & (res["flags"] == 0)].groupby("station_rx"):
-        row[f"rms_mm_s.{st}"] = float(np.sqrt(np.mean(g["postfit_los"] ** 2)) * 1e3)
+    row = {"arc": name}
+    for obs, suffix, key in (("doppler_2way", "", "rms_mm_s"), ("doppler_1way", "_1way", "rms1w_mm_s")):
+        ok = (res["status"] == "") & (res["observable"] == obs)
+        if obs == "doppler_1way" and not ok.any():
+            continue
+        row[f"fitted{suffix}"] = int((ok & (res["flags"] == 0)).sum())
+        row[f"edited{suffix}"] = int((ok & (res["flags"] != 0)).sum())
+        for st, g in res[ok & (res["flags"] == 0)].groupby("station_rx"):
+            row[f"{key}.{st}"] = float(np.sqrt(np.mean(g["postfit_los"] ** 2)) * 1e3)
     return row
 
 

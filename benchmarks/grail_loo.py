@@ -54,7 +54,7 @@ def collect(out: Path, names) -> tuple[pd.DataFrame, pd.DataFrame]:
         for a in done:
             row = arc_figures(out / cand, a)
             summary = pd.read_json(out / cand / a / "current" / "summary.json", typ="series")
-            rms = [v for k, v in row.items() if k.startswith("rms_mm_s.")]
+            rms = [v for k, v in row.items() if k.startswith(("rms_mm_s.", "rms1w_mm_s."))]  # one-way too
             arcs.append({"candidate": cand, **row, "converged": bool(summary["converged"]), "worst_rms": max(rms)})
         for a, b in PAIRS:
             if a in done and b in done:

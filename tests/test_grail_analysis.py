@@ -199,3 +199,32 @@ def test_diagnosis_says_when_the_estimated_offset_or_pass_biases_took_the_residu
     b = g["pass_id"].map(bias).to_numpy()
     assert estimated_terms(g, own)["pass_bias_estimated_explained"] == pytest.approx(
         1 - np.sum(g["r"] ** 2) / np.sum((g["r"].to_numpy() + b) ** 2))
+
+
+def test_report_table_gives_the_estimated_offset_with_its_sigma_in_ms_and_a_short_reason():
+    """The table fits the report's page (checked in headless Chromium at 1300 px: no scrollbar): the likely
+    cause is a short label (the summary above says it in full), the run's own time offset one cell."""
+    from odpipe.analysis.station_diagnostics import CAUSES, SHORT, report_table
+
+    rng = np.random.default_rng(5)
+    rows = pd.concat([_smooth_station(rng, s, amp=3e-4) for s in ("DSS-24", "DSS-34")], ignore_index=True)
+    params = pd.DataFrame({"name": ["timing.DSS-34"], "kind": ["timing"], "estimate": [0.0054], "sigma": [0.0075]})
+    shown, fmt = report_table(diagnose(rows, params=params))
+    assert shown["estimated time offset (ms)"].tolist()[1] == "5.4 ± 7.5" and pd.isna(shown["estimated time offset (ms)"][0])
+    assert set(SHORT) == set(CAUSES) and max(map(len, SHORT.values())) <= 24
+    assert shown["reason"].tolist() == ["none (smooth)"] * 2
+
+
+def test_rows_edited_before_the_fit_count_in_their_station_n_edited():
+    """04-10: DSS-34's a priori blunder (removed before the fit) showed n_edited 0 in the residual tables."""
+    from odpipe.products.residuals import statistics
+
+    res = pd.DataFrame({"station_rx": ["DSS-27"] * 3 + ["DSS-34"] * 3, "observable": "doppler_2way",
+                        "pass_id": [1, 1, 1, 2, 2, 3], "status": "", "flags": [0, 256, 0, 0, 0, 0],
+                        "apriori_los": 1e-3, "postfit_los": 1e-4})
+    before = pd.DataFrame({"station_rx": ["DSS-34"], "observable": ["doppler_2way"], "pass_id": [2]})
+    stats = statistics(res).set_index("station_rx")["n_edited"]
+    assert stats.to_dict() == {"DSS-27": 1, "DSS-34": 0}
+    assert statistics(res, edited_before=before).set_index("station_rx")["n_edited"].to_dict() == {"DSS-27": 1, "DSS-34": 1}
+    per_pass = statistics(res, by=("station_rx", "observable", "pass_id"), edited_before=before)
+    assert per_pass["n_edited"].tolist() == [1, 1, 0]

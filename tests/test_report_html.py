@@ -31,7 +31,7 @@ START, END = "2003-06-03T00:00:00", "2003-06-04T06:00:00"
 # Column headers without a unit: labels, counts and text.
 UNITLESS = {"station_rx", "observable", "pass_id", "n_used", "n_edited", "n_failed", "stage", "reason", "rows",
             "parameter", "kind", "maneuver", "overlap", "statistic", "arc", "error", "converged"}
-UNIT = re.compile(r"\((m|m/s|mm/s|s|h|Hz|RU|%|1|1/s|m/s²|sigma|UTC|chi-square)\)$")
+UNIT = re.compile(r"\((m|m/s|mm/s|s|ms|h|Hz|RU|%|1|1/s|m/s²|sigma|UTC|chi-square)\)$")
 ISO = re.compile(r"^\d{4}-\d\d-\d\dT\d\d:\d\d:\d\d(\.\d+)?$")
 DATE_LIKE = re.compile(r"\d{4}-\d\d-\d\d")
 TDB_SECONDS = re.compile(r"\b[1-9]\.\d+e\+0[89]\b")  # 1e8..1e10 s: TDB s past J2000 as they were shown

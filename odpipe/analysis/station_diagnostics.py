@@ -230,24 +230,37 @@ def summary(table: pd.DataFrame) -> str:
                     f"median); likely cause: {CAUSES[r.likely_cause]}." for r in out.itertuples())
 
 
+# the likely cause in a report table's cell: short, the summary above the table says it in full (CAUSES)
+SHORT = {"timing": "time-tag offset", "troposphere": "troposphere", "pass_bias": "per-pass bias",
+         "ramp_segment": "bad ramp segment", "timing_estimated": "time offset (estimated)",
+         "pass_bias_estimated": "pass biases (estimated)", "none": "none (smooth)"}
+
+
+def _plus_minus(value_ms, sigma_ms) -> list:
+    """"estimate ± sigma" (ms, 0.1 ms) per row; NaN where nothing was estimated."""
+    return [f"{v:.1f} ± {s:.1f}" if np.isfinite(v) else np.nan
+            for v, s in zip(np.asarray(value_ms, float), np.asarray(sigma_ms, float))]
+
+
 def report_table(table: pd.DataFrame) -> tuple[pd.DataFrame, dict]:
     """(table, formats) of a :func:`diagnose` table for a report, with units in the headers: the RMS against
-    the stations' median, explained fractions in %, the timing offset in s, the ramp-segment z in sigmas,
-    and the likely cause as ``reason``."""
-    pct = {"timing_explained": "timing: explained (%)", "troposphere_explained": "troposphere: explained (%)",
-           "pass_bias_explained": "pass bias: explained (%)"}
+    the stations' median, explained fractions in %, time offsets in ms (the estimated one with its sigma),
+    the ramp-segment z in sigmas, and the likely cause as a short ``reason`` (:data:`SHORT`); narrow enough
+    for the report's page."""
+    n = len(table)
     shown = pd.DataFrame({"station_rx": table["station"], "rows": table["rows"], "RMS (mm/s)": table["rms_mm_s"],
                           "RMS / median (1)": table["rms_mm_s"] / table["rms_mm_s"].median()})
-    for col, name in pct.items():
-        shown[name] = 100.0 * table.get(col, np.nan)
-    shown["timing offset (s)"] = table.get("timing_offset_ms", np.nan) / 1e3
-    shown["estimated time offset (s)"] = table.get("timing_estimated_ms", np.nan) / 1e3
-    shown["its sigma (s)"] = table.get("timing_estimated_sigma_ms", np.nan) / 1e3
+    for col, name in (("timing_explained", "timing"), ("troposphere_explained", "troposphere"),
+                      ("pass_bias_explained", "pass bias")):
+        shown[f"{name}: explained (%)"] = 100.0 * table.get(col, np.nan)
+    shown["timing offset (ms)"] = table.get("timing_offset_ms", np.nan)
+    shown["estimated time offset (ms)"] = _plus_minus(table.get("timing_estimated_ms", np.full(n, np.nan)),
+                                                      table.get("timing_estimated_sigma_ms", np.full(n, np.nan)))
     shown["estimated offset: explained (%)"] = 100.0 * table.get("timing_estimated_explained", np.nan)
     shown["estimated pass biases: explained (%)"] = 100.0 * table.get("pass_bias_estimated_explained", np.nan)
     shown["worst ramp segment (mm/s)"] = table.get("segment_offset_mm_s", np.nan)
     shown["its offset (sigma)"] = table.get("segment_z", np.nan)
-    shown["reason"] = table["likely_cause"].map(CAUSES)
-    fmt = {c: "{:.2f}" for c in shown.columns if c not in ("station_rx", "rows", "reason")}
-    return shown, fmt | {"timing offset (s)": "{:.5f}", "estimated time offset (s)": "{:.5f}",
-                         "its sigma (s)": "{:.5f}", "RMS / median (1)": "{:.1f}"}
+    shown["reason"] = table["likely_cause"].map(SHORT)
+    fmt = {c: "{:.0f}" for c in shown.columns if c.endswith("(%)")}
+    return shown, fmt | {"RMS (mm/s)": "{:.2f}", "RMS / median (1)": "{:.1f}", "timing offset (ms)": "{:.1f}",
+                         "worst ramp segment (mm/s)": "{:.2f}", "its offset (sigma)": "{:.1f}"}

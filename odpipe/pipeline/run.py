@@ -36,6 +36,7 @@ from odpipe.preprocess.apriori_blunders import apriori_blunders
 from odpipe.preprocess.compress import compress
 from odpipe.preprocess.edit import EditConfig, edit
 from odpipe.preprocess.flags import Flag
+from odpipe.preprocess.flags import summary as flag_summary
 from odpipe.products import parameters, residuals
 from parsers.atomic import write_parquet, write_text
 from odpipe.products.oem import write_oem
@@ -141,10 +142,12 @@ def _run(cfg: RunConfig, attempt, log: RunLog, fingerprint: dict) -> dict:
                           arc=(np.datetime64(cfg.arc.start, "ns"), np.datetime64(cfg.arc.end, "ns")))
     table, edits = edit(table, data.ramps, edit_cfg)
     log("edit: " + ", ".join(f"{r} {n}" for r, n in zip(edits["reason"], edits["rows"]) if n))
+    before = table.iloc[:0]   # rows edited before the fit by a test on the rows it is given (per-station counts)
     if pre.apriori_blunder_k is not None:
         bad = apriori_blunders(table, apriori, setup.measurements, cfg.arc.spacecraft, pre.apriori_blunder_k,
                                table["flags"].to_numpy() == 0)
         table.loc[bad, "flags"] = table.loc[bad, "flags"] | int(Flag.BLUNDER)
+        before, edits = table[bad], flag_summary(table["flags"])
         log(f"edit: blunders against the a priori orbit {int(bad.sum())}")
 
     t0 = time.perf_counter()
@@ -164,7 +167,7 @@ def _run(cfg: RunConfig, attempt, log: RunLog, fingerprint: dict) -> dict:
         arc = _fit(table, replace(setup, maneuvers=tuple(setup.maneuvers) + added), log, shared,
                    after=(arc, "refit: detected maneuvers estimated"))
     fit_seconds = time.perf_counter() - t0
-    return _products(cfg, attempt, log, table, arc, edits, fit_seconds, findings, fingerprint, data.ramps)
+    return _products(cfg, attempt, log, table, arc, edits, fit_seconds, findings, fingerprint, data.ramps, before)
 
 
 MAX_EPOCH_WINDOW_S = 600.0  # s: a burn found between rows closer than this also gets its epoch estimated
@@ -211,13 +214,14 @@ def unlogged_maneuvers(res: pd.DataFrame, window: int = 20, p_false: float = 1e-
     return out
 
 
-def _products(cfg, attempt, log, table, arc, edits, fit_seconds, findings, fingerprint, ramps=None) -> dict:
+def _products(cfg, attempt, log, table, arc, edits, fit_seconds, findings, fingerprint, ramps=None,
+              before=None) -> dict:
     res = arc.residuals
-    stats = residuals.statistics(res)
+    stats = residuals.statistics(res, edited_before=before)
     write_parquet(attempt.product("tracking.parquet"), table)
     write_parquet(attempt.product("residuals.parquet"), res)
     write_text(attempt.product("residual_statistics.csv"), stats.to_csv(index=False))
-    per_pass = residuals.statistics(res, by=("station_rx", "observable", "pass_id"))
+    per_pass = residuals.statistics(res, by=("station_rx", "observable", "pass_id"), edited_before=before)
     write_text(attempt.product("residual_statistics_passes.csv"), per_pass.to_csv(index=False))
     diag = station_diagnostics.diagnose(station_diagnostics.rows_used(res, table, ramps), params=arc.parameters)
     write_text(attempt.product("station_diagnostics.csv"), diag.to_csv(index=False))

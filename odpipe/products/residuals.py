@@ -33,8 +33,9 @@ def _rms(x) -> float:
 LOS_UNIT = {True: "m/s", False: "m"}
 
 
-def statistics(res: pd.DataFrame, by=("station_rx", "observable")) -> pd.DataFrame:
-    """Per group: rows fitted (``n_used``), edited by the fit (``n_edited``) and not computable by the
+def statistics(res: pd.DataFrame, by=("station_rx", "observable"), edited_before=None) -> pd.DataFrame:
+    """Per group: rows fitted (``n_used``), edited by the fit or, the tracking rows ``edited_before`` (e.g. the
+    a priori blunder test's), before it (``n_edited``) and not computable by the
     models (``n_failed``); first and last epoch (UTC) of the used rows; mean and RMS of the post-fit and
     RMS of the pre-fit residual against the a priori (``apriori_los``, the first iteration's), all
     along the line of sight in ``los_unit`` (m or m/s); and the post-fit RMS in the observable's own
@@ -45,6 +46,8 @@ def statistics(res: pd.DataFrame, by=("station_rx", "observable")) -> pd.DataFra
     g = used.groupby(by, sort=True)
     out = pd.DataFrame({"n_used": g.size()})
     out["n_edited"] = _count(res[ok & res["flags"].ne(0)], by, out.index)
+    if edited_before is not None:
+        out["n_edited"] += _count(edited_before, by, out.index)
     out["n_failed"] = _count(res[~ok], by, out.index)
     if "epoch" in used:
         out["start"], out["end"] = g["epoch"].min(), g["epoch"].max()
