@@ -43,9 +43,9 @@ def test_acceleration_and_gradient_vs_potential(r):
     nmax, gm, radius = 12, 3.986004415e14, 6378136.3
     C, S = _random_field(nmax, 7)
     r = np.array(r)
-    start, T = field_table(C, S, nmax, nmax)
+    T = field_table(C, S, nmax, nmax)
     acc, grad = np.zeros(3), np.zeros((3, 3))
-    sh_acceleration(r, gm, radius, start, T, nmax, nmax, workspace(nmax, nmax), acc, grad)
+    sh_acceleration(r, gm, radius, T, nmax, nmax, workspace(nmax, nmax), acc, grad)
     central = -gm * r / np.linalg.norm(r) ** 3
     h = 10.0
     ref_acc = np.zeros(3)
@@ -77,11 +77,11 @@ def test_degree_200_lunar_field_low_orbit(shared_data):
     from odpipe.environment.gravity import read_gravity
 
     g = read_gravity(shared_data / "gravity/tudat/lpe200.txt")
-    start, T = field_table(g.C, g.S, 200, -1)
+    T = field_table(g.C, g.S, 200, -1)
     for r in ([1.2e6, 0.8e6, 0.9e6], [1.0e3, -2.0e3, 1.793e6]):
         r = np.array(r) * 1.793e6 / np.linalg.norm(r)
         acc, grad = np.zeros(3), np.zeros((3, 3))
-        sh_acceleration(r, g.gm, g.radius, start, T, 200, -1, workspace(200, -1), acc, grad)
+        sh_acceleration(r, g.gm, g.radius, T, 200, -1, workspace(200, -1), acc, grad)
         h = 2.0
         ref = np.array([(_potential(r + e, g.gm, g.radius, g.C, g.S, 200)
                          - _potential(r - e, g.gm, g.radius, g.C, g.S, 200)) / (2 * h)
@@ -139,12 +139,12 @@ def test_reassociated_sums_within_1e12_of_exactly_rounded_sums(shared_data):
     g = read_gravity(shared_data / "gravity/tudat/lpe200.txt")
     nmax, ngrad = 120, 40
     C, S = g.truncated(nmax).C, g.truncated(nmax).S
-    start, T = field_table(C, S, nmax, ngrad)
+    T = field_table(C, S, nmax, ngrad)
     f = recursion_factors(nmax + 2)
     for r in ([1.2e6, 0.8e6, 0.9e6], [1.0e3, -2.0e3, 1.8e6], [-0.3e6, 1.7e6, -0.2e6]):
         r = np.array(r) * (g.radius + 30e3) / np.linalg.norm(r)
         acc, grad = np.zeros(3), np.zeros((3, 3))
-        sh_acceleration(r, g.gm, g.radius, start, T, nmax, ngrad, workspace(nmax, ngrad), acc, grad)
+        sh_acceleration(r, g.gm, g.radius, T, nmax, ngrad, workspace(nmax, ngrad), acc, grad)
         V, W = _solid_harmonics(r, g.radius, nmax + 2, f)
         first = _derivatives(V, W, f)
         ref = np.array([_exact_sum(C, S, *first[a], nmax) for a in "xyz"]) * g.gm / g.radius**2
@@ -152,3 +152,28 @@ def test_reassociated_sums_within_1e12_of_exactly_rounded_sums(shared_data):
                              for a in "xyz"]) * g.gm / g.radius**3
         np.testing.assert_allclose(acc, ref, rtol=0, atol=1e-12 * np.linalg.norm(ref))
         np.testing.assert_allclose(grad, ref_grad, rtol=0, atol=1e-12 * np.abs(ref_grad).max())
+
+
+@pytest.mark.parametrize("r", [[0.0, 0.0, 7.1e6], [0.0, 0.0, -6.9e6], [1e-3, -2e-3, 7.0e6],
+                               [7.0e6, 0.0, 0.0], [3.1e6, -4.4e6, 4.0e6]])
+def test_j2_field_matches_closed_form_including_the_polar_axis(r):
+    """J2 only: a = -3/2 J2 GM R^2 / r^5 (x (1 - 5 z^2/r^2), y (1 - 5 z^2/r^2), z (3 - 5 z^2/r^2)),
+    on the spin axis too (longitude undefined), with the gradient as its derivative."""
+    gm, radius, j2 = 3.986004415e14, 6378136.3, 1.0826e-3
+    C, S = np.zeros((3, 3)), np.zeros((3, 3))
+    C[0, 0], C[2, 0] = 1.0, -j2 / np.sqrt(5.0)
+
+    def closed_form(p):
+        x, y, z = p
+        rn = np.linalg.norm(p)
+        k = -1.5 * j2 * gm * radius**2 / rn**5
+        return -gm * p / rn**3 + k * np.array([x * (1 - 5 * z * z / rn**2), y * (1 - 5 * z * z / rn**2),
+                                               z * (3 - 5 * z * z / rn**2)])
+
+    r = np.array(r)
+    acc, grad = np.zeros(3), np.zeros((3, 3))
+    sh_acceleration(r, gm, radius, field_table(C, S, 2, 2), 2, 2, workspace(2, 2), acc, grad)
+    np.testing.assert_allclose(acc, closed_form(r), rtol=1e-14, atol=0)
+    h = 1.0
+    ref_grad = np.column_stack([(closed_form(r + e) - closed_form(r - e)) / (2 * h) for e in np.eye(3) * h])
+    np.testing.assert_allclose(grad, ref_grad, rtol=0, atol=1e-7 * np.abs(ref_grad).max())

@@ -36,10 +36,10 @@ class SphericalHarmonics:
     rotation: Callable | None = None
 
 
-# Per field k: its packed table start[k], T[k] (harmonics.field_table); gm (m^3/s^2), radius (m),
+# Per field k: its packed table T[k] (harmonics.field_table); gm (m^3/s^2), radius (m),
 # degree, grad_degree (-1: no gradient), slot (env.pos row, -1: the centre); the rotation table (channel k);
 # the kernel's scratch array (harmonics.workspace for the largest field, then 36 for the frame changes).
-HarmonicsData = namedtuple("HarmonicsData", ["start", "T", "gm", "radius", "degree", "grad_degree", "slot",
+HarmonicsData = namedtuple("HarmonicsData", ["T", "gm", "radius", "degree", "grad_degree", "slot",
                                              "rot_coefs", "rot_meta", "work"])
 FRAME_SCRATCH = 36
 
@@ -93,13 +93,12 @@ def _compile(components, ctx) -> HarmonicsData:
         slot[k] = ctx.slot.get(body, -1) if body != ctx.center else -1
         tables.append(_field_table(s.field, s.degree, int(grad_degree[k])))
     rot_coefs, rot_meta = stack_channels(channels)
-    start = np.zeros((max(1, n), max([st.size for st, _ in tables] + [1])), dtype=np.int64)
-    T = np.zeros((max(1, n), ROWS, max([t.shape[1] for _, t in tables] + [1])))
-    for k, (st, t) in enumerate(tables):
-        start[k, : st.size], T[k, :, : t.shape[1]] = st, t
+    T = np.zeros((max(1, n), ROWS, max([t.shape[1] for t in tables] + [1])))
+    for k, t in enumerate(tables):
+        T[k, :, : t.shape[1]] = t
     work = np.concatenate([workspace(int(degree.max(initial=2)), int(grad_degree.max(initial=-1))),
                            np.zeros(FRAME_SCRATCH)])
-    return HarmonicsData(start, T, gm, radius, degree, grad_degree, slot, rot_coefs, rot_meta, work)
+    return HarmonicsData(T, gm, radius, degree, grad_degree, slot, rot_coefs, rot_meta, work)
 
 
 @kernel(HarmonicsData)
@@ -119,7 +118,7 @@ def _kernel(data, t, r, v, env, acc, grad_r, grad_v, dadp):
         for i in range(3):
             r_bf[i] = M[i, 0] * rel[0] + M[i, 1] * rel[1] + M[i, 2] * rel[2]
         ngrad = data.grad_degree[k]
-        sh_acceleration(r_bf, data.gm[k], data.radius[k], data.start[k], data.T[k], data.degree[k], ngrad,
+        sh_acceleration(r_bf, data.gm[k], data.radius[k], data.T[k], data.degree[k], ngrad,
                         data.work, a_bf, g_bf)
         for i in range(3):
             acc[i] += M[0, i] * a_bf[0] + M[1, i] * a_bf[1] + M[2, i] * a_bf[2]
