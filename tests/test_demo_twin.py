@@ -78,10 +78,16 @@ def test_twin_carries_the_error_sources():
 
 
 @pytest.fixture(scope="module")
-def twin_truth(tmp_path_factory):
+def twin_dir(tmp_path_factory):
+    """A demo folder whose ``case/`` holds the twin's first 14 days, simulated once for this module."""
+    return tmp_path_factory.mktemp("twin")
+
+
+@pytest.fixture(scope="module")
+def twin_truth(twin_dir):
     from odpipe.simulate import run_case
 
-    return run_case(TWIN, tmp_path_factory.mktemp("twin"), days=14.0)
+    return run_case(TWIN, twin_dir / "case", days=14.0)
 
 
 @pytest.mark.slow
@@ -117,11 +123,11 @@ def test_twin_recorded_figures_against_the_thesis():
 
 
 @pytest.mark.slow
-def test_twin_14_days_snapshot(tmp_path):
+def test_twin_14_days_snapshot(twin_dir, twin_truth):
     from odpipe.pipeline.demo import run_demo
 
-    run_demo(tmp_path, 2, progress=lambda *_: None, days=14.0, case=load(TWIN))
-    got = pd.read_csv(tmp_path / "thesis_comparison.csv")
+    run_demo(twin_dir, 2, progress=lambda *_: None, days=14.0, case=load(TWIN))   # fits twin_truth's files
+    got = pd.read_csv(twin_dir / "thesis_comparison.csv")
     want = pd.read_csv(FIXTURES / "twin_14d_figures.csv")
     for figure in want["figure"]:
         g, w = _mean(got, figure), _mean(want, figure)
