@@ -82,7 +82,8 @@ class ArcSetup:
     when doppler_1way is fitted (a priori and reference epoch from ``measurements.oscillators``).
     station_sigma: considered (not estimated) error of each station's ITRS coordinates (m per axis).
     media_sigma: considered error of the media calibration scale (fraction of ``media_m``).
-    edit_k: innovation k-sigma per iteration (last repeats); reweight: ARTEMIS data reweighting.
+    edit_k: innovation k-sigma per iteration (last repeats); reweight: ARTEMIS data reweighting; tol_dx:
+    converged when the last pass's epoch correction is below this many sigma (:class:`FitOptions`).
     sigma_scale: data-weight stages (loose to tight; see :class:`FitOptions`).
     block: filter grid spacing (s); measurement_epochs: every row's epoch on the grid too (one update per
     epoch: a sequential filter's innovations); lookback: s of trajectory kept before each segment start.
@@ -122,6 +123,7 @@ class ArcSetup:
     block: float = FitOptions.block
     measurement_epochs: bool = FitOptions.output_at_measurements
     edit_against_reference: bool = FitOptions.edit_against_reference
+    tol_dx: float = FitOptions.tol_dx
     lookback: float = 120.0
     growing_days: float | None = 2.0  # first span of the growing-arc start (None: fit the whole arc at once)
     tabulate_earth_rotation: bool = True
@@ -334,7 +336,7 @@ def fit_arc(table: pd.DataFrame, setup: ArcSetup, shared: dict | None = None) ->
     options = FitOptions(max_iter=setup.max_iter, block=setup.block, edit_k=tuple(setup.edit_k),
                          reweight=setup.reweight, sigma_scale=tuple(setup.sigma_scale),
                          output_at_measurements=setup.measurement_epochs,
-                         edit_against_reference=setup.edit_against_reference)
+                         edit_against_reference=setup.edit_against_reference, tol_dx=setup.tol_dx)
     grid, _ = build_grid(reg, setup.start, setup.end, options.block, options.extra_epochs)
 
     meas = setup.measurements

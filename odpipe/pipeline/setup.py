@@ -170,7 +170,7 @@ def arc_setup(cfg: RunConfig, fm: F.ForceModel, ramps, catalog: StationCatalog) 
                     edit_k=tuple(est.edit_k), max_iter=est.max_iter, reweight=est.reweight,
                     sigma_scale=tuple(est.sigma_scale), block=est.block,
                     measurement_epochs=est.measurement_epochs,
-                    edit_against_reference=est.edit_against_reference)
+                    edit_against_reference=est.edit_against_reference, tol_dx=est.tol_dx)
 
 
 def bias_apriori(est) -> dict:
