@@ -90,7 +90,8 @@ class ArcSetup:
     tabulate_earth_rotation: evaluate the GCRS->ITRS matrix from a per-arc Chebyshev table
     (:mod:`.rotation`, < 1e-12 rad) instead of the full model at every event.
     coarse_integration: integrator settings of the references of the fit's loose-weight stages
-    (all ``sigma_scale`` stages but the last; None: exact throughout).
+    (all ``sigma_scale`` stages but the last; None: exact throughout); integration: ``rtol``/``atol``
+    of the exact references (empty: :class:`~.problem.TrackingProblem`'s).
     """
 
     spacecraft: str
@@ -129,6 +130,7 @@ class ArcSetup:
     tabulate_earth_rotation: bool = True
     outward: tuple | None = None
     coarse_integration: dict | None = field(default_factory=lambda: dict(COARSE_INTEGRATION))
+    integration: dict = field(default_factory=dict)
 
 
 @dataclass
@@ -304,7 +306,7 @@ def a_priori_reference(setup: ArcSetup, shared: dict) -> ReferenceChain:
     grid, _ = build_grid(reg, setup.start, setup.end, setup.block)
     problem = TrackingProblem(reg, pd.DataFrame(), np.zeros(0), {setup.spacecraft: setup.force_model},
                               setup.measurements, setup.start, setup.end, setup.lookback, epochs=grid,
-                              shared=shared, coarse=setup.coarse_integration)
+                              shared=shared, coarse=setup.coarse_integration, **setup.integration)
     problem.set_coarse(len(setup.sigma_scale) > 1)   # as the fit flies its first pass
     starts, trajs = [], []
     t, x = setup.start, reg.apriori
@@ -348,7 +350,8 @@ def fit_arc(table: pd.DataFrame, setup: ArcSetup, shared: dict | None = None) ->
 
     def problem_for(r, t):
         prob = TrackingProblem(reg, r, t, {setup.spacecraft: setup.force_model}, meas, setup.start, setup.end,
-                               setup.lookback, epochs=grid, shared=shared, coarse=setup.coarse_integration)
+                               setup.lookback, epochs=grid, shared=shared, coarse=setup.coarse_integration,
+                               **setup.integration)
         prob.set_coarse(len(options.sigma_scale) > 1)   # as the fit flies its first pass
         return prob
 
