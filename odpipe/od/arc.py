@@ -84,14 +84,16 @@ class ArcSetup:
     station_sigma: considered (not estimated) error of each station's ITRS coordinates (m per axis).
     station_position_sigma: {station: m per ITRS axis}: those stations' coordinate offsets estimated (a priori 0).
     media_sigma: considered error of the media calibration scale (fraction of ``media_m``).
-    edit_k: innovation k-sigma per iteration (last repeats); reweight: ARTEMIS data reweighting.
+    edit_k: innovation k-sigma per iteration (last repeats); reweight: ARTEMIS data reweighting; tol_dx:
+    converged when the last pass's epoch correction is below this many sigma (:class:`FitOptions`).
     sigma_scale: data-weight stages (loose to tight; see :class:`FitOptions`).
     block: filter grid spacing (s); measurement_epochs: every row's epoch on the grid too (one update per
     epoch: a sequential filter's innovations); lookback: s of trajectory kept before each segment start.
     tabulate_earth_rotation: evaluate the GCRS->ITRS matrix from a per-arc Chebyshev table
     (:mod:`.rotation`, < 1e-12 rad) instead of the full model at every event.
     coarse_integration: integrator settings of the references of the fit's loose-weight stages
-    (all ``sigma_scale`` stages but the last; None: exact throughout).
+    (all ``sigma_scale`` stages but the last; None: exact throughout); integration: ``rtol``/``atol``
+    of the exact references (empty: :class:`~.problem.TrackingProblem`'s).
     """
 
     spacecraft: str
@@ -126,11 +128,13 @@ class ArcSetup:
     block: float = FitOptions.block
     measurement_epochs: bool = FitOptions.output_at_measurements
     edit_against_reference: bool = FitOptions.edit_against_reference
+    tol_dx: float = FitOptions.tol_dx
     lookback: float = 120.0
     growing_days: float | None = 2.0  # first span of the growing-arc start (None: fit the whole arc at once)
     tabulate_earth_rotation: bool = True
     outward: tuple | None = None
     coarse_integration: dict | None = field(default_factory=lambda: dict(COARSE_INTEGRATION))
+    integration: dict = field(default_factory=dict)
 
 
 @dataclass
@@ -312,7 +316,7 @@ def a_priori_reference(setup: ArcSetup, shared: dict) -> ReferenceChain:
     grid, _ = build_grid(reg, setup.start, setup.end, setup.block)
     problem = TrackingProblem(reg, pd.DataFrame(), np.zeros(0), {setup.spacecraft: setup.force_model},
                               setup.measurements, setup.start, setup.end, setup.lookback, epochs=grid,
-                              shared=shared, coarse=setup.coarse_integration)
+                              shared=shared, coarse=setup.coarse_integration, **setup.integration)
     problem.set_coarse(len(setup.sigma_scale) > 1)   # as the fit flies its first pass
     starts, trajs = [], []
     t, x = setup.start, reg.apriori
@@ -344,7 +348,7 @@ def fit_arc(table: pd.DataFrame, setup: ArcSetup, shared: dict | None = None) ->
     options = FitOptions(max_iter=setup.max_iter, block=setup.block, edit_k=tuple(setup.edit_k),
                          reweight=setup.reweight, sigma_scale=tuple(setup.sigma_scale),
                          output_at_measurements=setup.measurement_epochs,
-                         edit_against_reference=setup.edit_against_reference)
+                         edit_against_reference=setup.edit_against_reference, tol_dx=setup.tol_dx)
     grid, _ = build_grid(reg, setup.start, setup.end, options.block, options.extra_epochs)
 
     meas = setup.measurements
@@ -356,7 +360,8 @@ def fit_arc(table: pd.DataFrame, setup: ArcSetup, shared: dict | None = None) ->
 
     def problem_for(r, t):
         prob = TrackingProblem(reg, r, t, {setup.spacecraft: setup.force_model}, meas, setup.start, setup.end,
-                               setup.lookback, epochs=grid, shared=shared, coarse=setup.coarse_integration)
+                               setup.lookback, epochs=grid, shared=shared, coarse=setup.coarse_integration,
+                               **setup.integration)
         prob.set_coarse(len(options.sigma_scale) > 1)   # as the fit flies its first pass
         return prob
 

@@ -411,6 +411,14 @@ class EstimationSection:
     # the epoch correction is below 1 sigma, so a far-off a priori is not fitted at full weight at once
     sigma_scale: list[float] = checked(positive, default_factory=lambda: list(FitOptions.sigma_scale))
     block: float = checked(positive, default=FitOptions.block)  # s, filter grid step
+    # converged when the epoch correction of an exact pass is below this many sigma (the products apply
+    # that last correction to first order)
+    tol_dx: float = checked(positive, default=FitOptions.tol_dx)
+    reference_rtol: float | None = checked(positive, default=None)  # relative tolerance of the fit's exact references (none: 1e-12)
+    reference_atol: float | None = checked(positive, default=None)  # m, m/s: their absolute tolerance (none: 1e-6)
+    # relative tolerance of the references of the loose-weight stages (every sigma_scale stage but the last; none: 1e-9)
+    coarse_rtol: float | None = checked(positive, default=None)
+    coarse_atol: float | None = checked(positive, default=None)  # m, m/s: their absolute tolerance (none: 1e-5)
     # every measurement epoch on the filter grid too: one update per epoch, so the innovations are a
     # sequential filter's, measurement by measurement (Orekit's Kalman); false: the rows of a block at once
     measurement_epochs: bool = FitOptions.output_at_measurements

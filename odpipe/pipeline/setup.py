@@ -18,7 +18,7 @@ from odpipe.frames.earth import gcrs_to_itrs
 from odpipe.frames.eme2000 import eme2000_to_gcrs
 from odpipe.frames.local import rtn_matrix
 from odpipe.measurements import MeasurementSetup
-from odpipe.od.arc import ArcSetup, ManeuverPlan, sigma_value
+from odpipe.od.arc import COARSE_INTEGRATION, ArcSetup, ManeuverPlan, sigma_value
 from odpipe.pipeline.config import RunConfig
 from odpipe.operations.schema import ConfigError
 from odpipe.time import utc_to_tdb
@@ -177,7 +177,14 @@ def arc_setup(cfg: RunConfig, fm: F.ForceModel, ramps, catalog: StationCatalog) 
                     edit_k=tuple(est.edit_k), max_iter=est.max_iter, reweight=est.reweight,
                     sigma_scale=tuple(est.sigma_scale), block=est.block,
                     measurement_epochs=est.measurement_epochs,
-                    edit_against_reference=est.edit_against_reference)
+                    edit_against_reference=est.edit_against_reference, tol_dx=est.tol_dx,
+                    integration=_tolerances({}, est.reference_rtol, est.reference_atol),
+                    coarse_integration=_tolerances(COARSE_INTEGRATION, est.coarse_rtol, est.coarse_atol))
+
+
+def _tolerances(default: dict, rtol: float | None, atol: float | None) -> dict:
+    """Integrator settings: ``default`` with the ``rtol``/``atol`` given (None: the default's)."""
+    return {**default, **{k: v for k, v in (("rtol", rtol), ("atol", atol)) if v is not None}}
 
 
 def bias_apriori(est) -> dict:
