@@ -266,7 +266,8 @@ def build_registry(setup: ArcSetup, rows: pd.DataFrame) -> ParameterRegistry:
         y0, y1, _ = setup.measurements.oscillators[sc]
         reg.add(f"{sc}.osc_y0", "clock", y0, setup.oscillator_sigma[0], owner=sc, oscillator="y0")
         reg.add(f"{sc}.osc_y1", "clock", y1, setup.oscillator_sigma[1], owner=sc, oscillator="y1")
-    tracking = set(rows["station_rx"]) | set(rows["station_tx"]) - {""}
+    tx = rows["station_tx"] if "station_tx" in rows else ()
+    tracking = (set(rows["station_rx"]) | set(tx)) - {""}
     for st in sorted(tracking & set(setup.station_position_sigma)):
         for axis in "xyz":
             reg.add(f"station.{st}.{axis}", "station", 0.0, setup.station_position_sigma[st], owner=st, axis=axis)
