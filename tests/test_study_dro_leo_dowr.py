@@ -173,3 +173,44 @@ def test_whole_run_table13_against_the_paper():
     # the paper's orderings: DOWR beats one-way ranging on the DRO, the true model beats Model-B
     assert results["Simu. 8"]["DRO"]["pos"] > 5 * results["Simu. 2"]["DRO"]["pos"]
     assert results["Simu. 2"]["DRO"]["pos"] > 10 * results["Simu. 6"]["DRO"]["pos"]
+
+
+def test_pass_plan_phase_and_dowr_in_a_one_way_pass_s_place(meas, monkeypatch):
+    """Simu. 9's plan (sec. 2.2 (3)): one-way 1 h every 12 h, DOWR 1 h every 120 h from ``first_h``. A DOWR pass at
+    a one-way pass's start takes its place (no one-way rows at those epochs); one from 6 h falls between two."""
+    cfg = dict(CFG, arc_days=10.0)
+    hours = (dowr.pass_epochs(cfg, 120.0, 24.0) - EPOCH) / np.timedelta64(1, "s") / 3600.0
+    assert hours.size == 2 * 60 and hours[0] == 24.0 + 1 / 60 and hours[60] == 144.0 + 1 / 60   # 1-min samples
+    assert dowr.pass_epochs(cfg, 12.0).size == 20 * 60                                          # 0, 12, ..., 228 h
+
+    class Fixed:                        # far apart, the link clear of the Earth at every epoch
+        def __init__(self, x):
+            self.x = x
+
+        def state(self, t):
+            return np.tile([self.x, 0, 0, 0, 0, 0], (np.size(t), 1)).astype(float)
+
+    def noise_free(rows, truth, setup):
+        return type("Ev", (), {"value": np.full(len(rows), 3.9e8), "status": np.full(len(rows), "", object)})()
+
+    monkeypatch.setattr(dowr, "compute", noise_free)
+    clocks = dowr.ClockTruth(CFG["clock"], T0, T0 + 10 * 86400.0, np.random.default_rng(1))
+    for first, n_oneway in ((24.0, 18 * 60), (6.0, 20 * 60)):
+        plan = [{"type": "oneway", "every_h": 12.0}, {"type": "dowr", "every_h": 120.0, "first_h": first}]
+        rows, _ = dowr.simulate(cfg, meas, {"DRO": Fixed(4e8), "LEO": Fixed(7e6)}, clocks, plan,
+                                np.random.default_rng(2))
+        counts = rows["observable"].value_counts()
+        assert counts[dowr.ONE_WAY] == n_oneway and counts["dowr_sum"] == counts["dowr_diff"] == 2 * 60, first
+
+
+def test_variant_spread_is_min_median_max_over_the_variants():
+    sims = [{"name": f"v{i}", "variant_of": "Simu. 9",
+             "paper": {"clock_ns": 40.0, "DRO": {"pos_m": 80.0}, "LEO": {"pos_m": 20.0}}} for i in range(3)]
+    sims.append({"name": "alone", "paper": sims[0]["paper"]})
+    results = {f"v{i}": {"DRO": {"pos": p}, "LEO": {"pos": 10.0}, "clock_ns": 40.0 * (i + 1)}
+               for i, p in enumerate((40.0, 160.0, 80.0))}
+    table = dowr.variant_spread(sims, results).set_index("figure")
+    assert list(table["variants"]) == [3, 3, 3]
+    assert table.loc["DRO pos [m]", ["odpipe min", "odpipe median", "odpipe max"]].tolist() == [40.0, 80.0, 160.0]
+    assert table.loc["DRO pos [m]", ["ratio min", "ratio median", "ratio max"]].tolist() == [0.5, 1.0, 2.0]
+    assert table.loc["clock [ns]", "ratio max"] == 3.0 and table.loc["LEO pos [m]", "ratio median"] == 0.5
