@@ -79,8 +79,10 @@ DIFFERENCES = """\
   accelerations held over ``batch_s`` with the same velocity-variance rate, so Simu. 4's 1e-8 m/s^2
   per 5-min step gives the DRO 22x Simu. 2's; the DRO clock offset gets a random walk of the truth's
   level (the paper holds its clock parameters constant in the time update).
-- Simu. 9: the paper does not say how DOWR and one-way passes alternate; here every other 12-h pass
-  is DOWR.
+- Simu. 9: the paper gives one-way ranging 1 h every 12 h and DOWR 1 h every 120 h (sec. 2.2 (3)), not where
+  the DOWR pass falls in the 120-h cycle nor whether it takes a one-way pass's place. study_dro_leo_dowr.toml
+  has DOWR on every other 12-h pass (24 h, 5x the paper's DOWR rate); study_dro_leo_dowr_alternation.toml
+  runs 120 h at six phases (``first_h``) and reports the spread (``variant_of``).
 - Models: DE440 (paper DE405), GGM02C (GGM01C) and LP165P (GL0120B); what matters is the truth-minus-
   filter truncation (70 -> 50 and 20 -> 15 in Model-B), which is kept.
 - Not given in the paper, chosen here: the LEO time error's correlation time, the clock a0, the delay,

@@ -586,7 +586,7 @@ class Sensitivity:
     """Cases refitted with the filter's accelerations scaled, and over the choices the thesis leaves open."""
 
     acc_scale: float = checked(positive)  # factor on acc_sigma_rtn
-    cases: list[str] = field(default_factory=list)  # the [cases.X] names refitted
+    cases: list[str] = field(default_factory=list)  # the [cases.X] names refitted with the accelerations scaled
     acc_tau_s: list[float] = checked(positive, default_factory=list)  # s, correlation times tau_cases are refitted with
     tau_cases: list[str] = field(default_factory=list)  # the [cases.X] names refitted over acc_tau_s
     geo_apriori_vel_mps: list[float] = checked(positive, default_factory=list)  # m/s, "ground" refitted with these
