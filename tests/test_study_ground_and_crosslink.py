@@ -28,7 +28,7 @@ from odpipe.studies import ground_and_crosslink as ground
 from odpipe.studies import schedule_trade
 from odpipe.studies.scenarios import load_config
 from odpipe.time import utc_to_tdb
-from study_runs import as_recorded, run_study, whole_run
+from study_runs import as_recorded, run_study, stored_figures, whole_run
 
 CFG = load_config(Path(__file__).parents[1] / "runs" / "study_ground_and_crosslink.toml")
 CASES = ("ground", "ground_liaison", "liaison")   # (inf, 0), (0, 0) and (0, inf) of the thesis' Fig. 8.4/8.5
@@ -275,3 +275,29 @@ def test_whole_run_geo_ground_only_and_the_correlation_time():
                                                                      ("30.8", "34.9", "35.8", "34.2")]
     assert halo.loc[3.0, "odpipe/thesis"] < 0.5 < halo.loc[24.0, "odpipe/thesis"]
     assert [geo[f"tau {h} h"] for h in (12, 72)] == [as_recorded("351"), as_recorded("350")]
+
+
+# odpipe's thesis figures per correlation time of the empirical accelerations (the thesis gives none), every case
+# with a thesis figure, as fixtures/studies/ground_and_crosslink_tau.csv records them from a whole run
+TAU = stored_figures("ground_and_crosslink_tau")
+PAPER_KEY = {"3s RMS d6-9": "rms_sig3", "final 3s": "final_sig3", "day 3s<100 m": "below100_d"}
+
+
+def _tau_ratios() -> dict:
+    """(case, spacecraft, figure) -> {tau h: odpipe/thesis} of the stored figures."""
+    out = {}
+    for r in TAU.itertuples():
+        thesis = CFG["paper"][r.case][f"{r.spacecraft}_{PAPER_KEY[r.figure]}"]
+        out.setdefault((r.case, r.spacecraft, r.figure), {})[float(r.tau_h)] = float(r.odpipe) / thesis
+    return out
+
+
+@whole_run
+@pytest.mark.realdata
+def test_whole_run_correlation_time_figures_as_stored():
+    """The whole run's figures per correlation time equal the stored ones to their recorded digits."""
+    tau = run_study("study_ground_and_crosslink")["tau_cases"]
+    got = {(r["case"], r["spacecraft"], r["figure"], r["tau h"]): r["odpipe"] for _, r in tau.iterrows()}
+    assert len(got) == len(TAU)
+    for r in TAU.itertuples():
+        assert got[(r.case, r.spacecraft, r.figure, float(r.tau_h))] == as_recorded(r.odpipe), r
