@@ -110,26 +110,36 @@ def test_stored_the_paper_s_ekf_is_not_the_cause():
 
 def test_stored_table6_halo_known_is_no_better_as_in_the_paper():
     """Table 6 (S band, the halo's state known): the paper finds the GEO satellite no better than with both states
-    estimated (79.3 against 75.0 m, 1.06x). Every estimator agrees on that (tolerance 0.8-1.2x, "not any better"
-    read as within 20 %), while the level stays below the paper's (recorded disagreement, as Tables 4-5)."""
+    estimated (79.3 against 75.0 m, 1.06x). The EKF agrees with SNC per interval (23.6 against 25.0 m, 0.94x) and
+    over the data gaps (48.4 against 49.4 m, 0.98x); tolerance 0.8-1.2x, "not any better" read as within 20 %. The
+    level stays below the paper's: 0.30x and 0.61x (recorded disagreement, as Tables 4-5)."""
     assert _paper("S_L1_known", "GEO") / _paper("S", "GEO") == pytest.approx(1.056, abs=1e-3)
-    for estimator in ("ekf",):
+    for estimator in ("ekf", "ekf_gap_snc"):
         assert 0.8 < _stored("S_L1_known", estimator, "GEO") / _stored("S", estimator, "GEO") < 1.2, estimator
     assert _stored("S_L1_known", "ekf", "GEO") / _paper("S_L1_known", "GEO") < 0.4
+    assert 0.5 < _stored("S_L1_known", "ekf_gap_snc", "GEO") / _paper("S_L1_known", "GEO") < 0.7
 
 
 def test_stored_snc_over_the_data_gaps_moves_toward_the_paper():
     """Eqs. 10-11 taken literally (Gamma Q Gamma^T over the time since the previous point, so the GEO cut-off's
     gaps of about 13 intervals get 13^2 times one interval's velocity variance instead of 13 times) multiply the
-    per-interval EKF's positions 2.5x or more in both bands and in Table 6. X band: L1 223 m and GEO 31.7 m,
-    0.75x / 0.40x the paper's. Tolerance: the halo within the factor 2 the other studies allow; GEO stays more than
-    2x better than the paper (recorded disagreement)."""
-    for case, sc in (("X", "L1"), ("X", "GEO")):
-        assert _stored(case, "ekf_gap_snc", sc) > 2.5 * _stored(case, "ekf", sc), (case, sc)
-    for band in ("X",):
+    per-interval EKF's positions 2.0-3.0x in both bands and in Table 6, every one toward the paper's:
+    S band L1 499 m (1.70x the paper's 293 m), GEO 49.4 m (0.66x); X band L1 223 m (0.75x), GEO 31.7 m (0.40x);
+    Table 6 GEO 48.4 m (0.61x). Tolerance: the halo within the factor 2 the other studies allow, in both bands;
+    GEO below the paper in every case (0.40-0.66x; the X band's outside the factor 2: recorded disagreement). The
+    S-band halo velocity, 7.48 mm/s, is 3.6x the paper's: the gap noise overshoots it where the per-interval EKF
+    was 1.8x."""
+    for case, sc in (("S", "L1"), ("S", "GEO"), ("X", "L1"), ("X", "GEO"), ("S_L1_known", "GEO")):
+        ratio = _stored(case, "ekf_gap_snc", sc) / _stored(case, "ekf", sc)
+        assert 1.9 < ratio < 3.5, (case, sc)
+        assert abs(np.log(_stored(case, "ekf_gap_snc", sc) / _paper(case, sc))) < abs(
+            np.log(_stored(case, "ekf", sc) / _paper(case, sc))), (case, sc)         # toward the paper's
+    for band in ("S", "X"):
         assert 0.5 < _stored(band, "ekf_gap_snc", "L1") / _paper(band, "L1") < 2.0, band
-    for case in ("X",):
-        assert _stored(case, "ekf_gap_snc", "GEO") / _paper(case, "GEO") < 0.5, case
+    for case in ("S", "X", "S_L1_known"):
+        assert _stored(case, "ekf_gap_snc", "GEO") / _paper(case, "GEO") < 0.7, case
+    assert _stored("X", "ekf_gap_snc", "GEO") / _paper("X", "GEO") < 0.5
+    assert _stored("S", "ekf_gap_snc", "L1", "Vel") / _paper("S", "L1", "Vel") > 3.0
 
 
 # the study on its first 1.5 days (S band and Table 6; the EKF with SNC per interval and over the data gaps), as
