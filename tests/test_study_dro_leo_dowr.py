@@ -18,7 +18,7 @@ from odpipe.measurements.crosslink import ClockModel, one_way_pseudorange
 from odpipe.measurements.lighttime import solve_path
 from odpipe.measurements.nodes import SpacecraftNode
 from odpipe.time import utc_to_tdb
-from study_runs import as_recorded, run_study, whole_run
+from study_runs import as_recorded, run_study, stored_figures, whole_run
 
 ROOT = Path(__file__).resolve().parents[1]
 CFG = load_config(ROOT / "runs/study_dro_leo_dowr.toml")
@@ -214,3 +214,45 @@ def test_variant_spread_is_min_median_max_over_the_variants():
     assert table.loc["DRO pos [m]", ["odpipe min", "odpipe median", "odpipe max"]].tolist() == [40.0, 80.0, 160.0]
     assert table.loc["DRO pos [m]", ["ratio min", "ratio median", "ratio max"]].tolist() == [0.5, 1.0, 2.0]
     assert table.loc["clock [ns]", "ratio max"] == 3.0 and table.loc["LEO pos [m]", "ratio median"] == 0.5
+
+
+# Simu. 9 over the DOWR pass's phase in its 120-h cycle (runs/study_dro_leo_dowr_alternation.toml), as
+# fixtures/studies/dro_leo_dowr_alternation.csv records the variants run: first_h -> figures (text)
+ALTERNATION = stored_figures("dro_leo_dowr_alternation")
+SIMU9 = next(s for s in CFG["simulation"] if s["name"] == "Simu. 9")
+
+
+def _alternation_ratios() -> dict:
+    """figure -> odpipe/paper over the stored variants."""
+    paper = {"DRO_pos_m": SIMU9["paper"]["DRO"]["pos_m"], "LEO_pos_m": SIMU9["paper"]["LEO"]["pos_m"],
+             "clock_ns": SIMU9["paper"]["clock_ns"]}
+    return {k: ALTERNATION[k].astype(float).to_numpy() / v for k, v in paper.items()}
+
+
+@whole_run
+def test_whole_run_alternation_as_stored():
+    """The whole alternation run gives the stored variants' figures to their recorded digits."""
+    results = run_study("study_dro_leo_dowr_alternation")["results"]
+    for r in ALTERNATION.itertuples():
+        acc = results[f"Simu. 9, DOWR every 120 h from {r.first_h} h"]
+        for got, want in ((acc["DRO"]["pos"], r.DRO_pos_m), (acc["LEO"]["pos"], r.LEO_pos_m),
+                          (acc["clock_ns"], r.clock_ns)):
+            assert got == as_recorded(want), r.first_h
+
+
+def test_stored_alternation_spread_against_the_paper():
+    """Simu. 9 with the paper's DOWR rate (1 h every 120 h), over where the DOWR pass falls in the cycle (the paper
+    does not say; stored: first_h 0 and 96 h): the DRO position is sensitive to that choice, 13.9-46.9 m (0.19-0.64x
+    the paper's 73.3 m, 3.4x between phases), and converges after 24.5-30.0 days (paper 30); the LEO (15.4-19.0 m,
+    0.68-0.84x of 22.6 m) and the clock (12.7-12.9 ns, 0.27-0.28x of 46.6 ns) hardly. The shipped Simu. 9 (DOWR every
+    24 h, 5x the paper's rate) gives the DRO 9.8 m, below the whole range. Tolerance: the LEO within the factor 2 of
+    the other Table 13 comparisons at every phase; the DRO below the paper at every phase (recorded disagreement,
+    how far depends on the phase); the clock 3.5x better (recorded: the truth clock's random walk between passes)."""
+    ratios = _alternation_ratios()
+    assert len(ALTERNATION) >= 2
+    assert np.all((0.5 < ratios["LEO_pos_m"]) & (ratios["LEO_pos_m"] < 2.0))
+    assert np.all(ratios["DRO_pos_m"] < 1.0) and ratios["DRO_pos_m"].max() / ratios["DRO_pos_m"].min() > 2.0
+    assert np.all(ratios["clock_ns"] < 0.5)
+    assert ALTERNATION["DRO_pos_m"].astype(float).min() > float(TABLE13["Simu. 9"][0])   # the 24-h plan's 9.8 m
+    conv = ALTERNATION["DRO_converge_d"].astype(float)
+    assert np.all((conv > 20.0) & (conv <= 30.5))
