@@ -13,11 +13,13 @@ import os
 import tempfile
 from pathlib import Path
 
+import pandas as pd
 import pytest
 
 from odpipe.studies.scenarios import load_config
 
 RUNS = Path(__file__).resolve().parents[1] / "runs"
+STORED = Path(__file__).resolve().parents[1] / "fixtures" / "studies"
 
 whole_run = pytest.mark.skipif(os.environ.get("ODPIPE_STUDY_RUNS", "") in ("", "0"),
                                reason="a whole study run (minutes): set ODPIPE_STUDY_RUNS=1")
@@ -35,3 +37,9 @@ def as_recorded(text: str):
     """A figure as docs/validation.md records it (e.g. "7.85"): equal to within half a unit of its last digit."""
     decimals = len(text.split(".")[1]) if "." in text else 0
     return pytest.approx(float(text), abs=0.5 * 10.0 ** -decimals)
+
+
+def stored_figures(name: str) -> pd.DataFrame:
+    """odpipe's figures of a whole study run as recorded in fixtures/studies/<name>.csv (the figure columns as
+    text, to the digits recorded: compare with :func:`as_recorded`)."""
+    return pd.read_csv(STORED / f"{name}.csv", comment="#", dtype=str, keep_default_na=False)

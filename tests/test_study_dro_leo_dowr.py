@@ -18,7 +18,7 @@ from odpipe.measurements.crosslink import ClockModel, one_way_pseudorange
 from odpipe.measurements.lighttime import solve_path
 from odpipe.measurements.nodes import SpacecraftNode
 from odpipe.time import utc_to_tdb
-from study_runs import as_recorded, run_study, whole_run
+from study_runs import as_recorded, run_study, stored_figures, whole_run
 
 ROOT = Path(__file__).resolve().parents[1]
 CFG = load_config(ROOT / "runs/study_dro_leo_dowr.toml")
@@ -173,3 +173,87 @@ def test_whole_run_table13_against_the_paper():
     # the paper's orderings: DOWR beats one-way ranging on the DRO, the true model beats Model-B
     assert results["Simu. 8"]["DRO"]["pos"] > 5 * results["Simu. 2"]["DRO"]["pos"]
     assert results["Simu. 2"]["DRO"]["pos"] > 10 * results["Simu. 6"]["DRO"]["pos"]
+
+
+def test_pass_plan_phase_and_dowr_in_a_one_way_pass_s_place(meas, monkeypatch):
+    """Simu. 9's plan (sec. 2.2 (3)): one-way 1 h every 12 h, DOWR 1 h every 120 h from ``first_h``. A DOWR pass at
+    a one-way pass's start takes its place (no one-way rows at those epochs); one from 6 h falls between two."""
+    cfg = dict(CFG, arc_days=10.0)
+    hours = (dowr.pass_epochs(cfg, 120.0, 24.0) - EPOCH) / np.timedelta64(1, "s") / 3600.0
+    assert hours.size == 2 * 60 and hours[0] == 24.0 + 1 / 60 and hours[60] == 144.0 + 1 / 60   # 1-min samples
+    assert dowr.pass_epochs(cfg, 12.0).size == 20 * 60                                          # 0, 12, ..., 228 h
+
+    class Fixed:                        # far apart, the link clear of the Earth at every epoch
+        def __init__(self, x):
+            self.x = x
+
+        def state(self, t):
+            return np.tile([self.x, 0, 0, 0, 0, 0], (np.size(t), 1)).astype(float)
+
+    def noise_free(rows, truth, setup):
+        return type("Ev", (), {"value": np.full(len(rows), 3.9e8), "status": np.full(len(rows), "", object)})()
+
+    monkeypatch.setattr(dowr, "compute", noise_free)
+    clocks = dowr.ClockTruth(CFG["clock"], T0, T0 + 10 * 86400.0, np.random.default_rng(1))
+    for first, n_oneway in ((24.0, 18 * 60), (6.0, 20 * 60)):
+        plan = [{"type": "oneway", "every_h": 12.0}, {"type": "dowr", "every_h": 120.0, "first_h": first}]
+        rows, _ = dowr.simulate(cfg, meas, {"DRO": Fixed(4e8), "LEO": Fixed(7e6)}, clocks, plan,
+                                np.random.default_rng(2))
+        counts = rows["observable"].value_counts()
+        assert counts[dowr.ONE_WAY] == n_oneway and counts["dowr_sum"] == counts["dowr_diff"] == 2 * 60, first
+
+
+def test_variant_spread_is_min_median_max_over_the_variants():
+    sims = [{"name": f"v{i}", "variant_of": "Simu. 9",
+             "paper": {"clock_ns": 40.0, "DRO": {"pos_m": 80.0}, "LEO": {"pos_m": 20.0}}} for i in range(3)]
+    sims.append({"name": "alone", "paper": sims[0]["paper"]})
+    results = {f"v{i}": {"DRO": {"pos": p}, "LEO": {"pos": 10.0}, "clock_ns": 40.0 * (i + 1)}
+               for i, p in enumerate((40.0, 160.0, 80.0))}
+    table = dowr.variant_spread(sims, results).set_index("figure")
+    assert list(table["variants"]) == [3, 3, 3]
+    assert table.loc["DRO pos [m]", ["odpipe min", "odpipe median", "odpipe max"]].tolist() == [40.0, 80.0, 160.0]
+    assert table.loc["DRO pos [m]", ["ratio min", "ratio median", "ratio max"]].tolist() == [0.5, 1.0, 2.0]
+    assert table.loc["clock [ns]", "ratio max"] == 3.0 and table.loc["LEO pos [m]", "ratio median"] == 0.5
+
+
+# Simu. 9 over the DOWR pass's phase in its 120-h cycle (runs/study_dro_leo_dowr_alternation.toml), as
+# fixtures/studies/dro_leo_dowr_alternation.csv records the variants run: first_h -> figures (text)
+ALTERNATION = stored_figures("dro_leo_dowr_alternation")
+SIMU9 = next(s for s in CFG["simulation"] if s["name"] == "Simu. 9")
+
+
+def _alternation_ratios() -> dict:
+    """figure -> odpipe/paper over the stored variants."""
+    paper = {"DRO_pos_m": SIMU9["paper"]["DRO"]["pos_m"], "LEO_pos_m": SIMU9["paper"]["LEO"]["pos_m"],
+             "clock_ns": SIMU9["paper"]["clock_ns"]}
+    return {k: ALTERNATION[k].astype(float).to_numpy() / v for k, v in paper.items()}
+
+
+@whole_run
+def test_whole_run_alternation_as_stored():
+    """The whole alternation run gives the stored variants' figures to their recorded digits."""
+    results = run_study("study_dro_leo_dowr_alternation")["results"]
+    for r in ALTERNATION.itertuples():
+        acc = results[f"Simu. 9, DOWR every 120 h from {r.first_h} h"]
+        for got, want in ((acc["DRO"]["pos"], r.DRO_pos_m), (acc["LEO"]["pos"], r.LEO_pos_m),
+                          (acc["clock_ns"], r.clock_ns)):
+            assert got == as_recorded(want), r.first_h
+
+
+def test_stored_alternation_spread_against_the_paper():
+    """Simu. 9 with the paper's DOWR rate (1 h every 120 h), over where the DOWR pass falls in the cycle (the paper
+    does not say; stored: first_h 0, 6, 24, 48, 72 and 96 h). The DRO position is sensitive to that choice:
+    13.9-46.9 m, odpipe/paper 0.19 / 0.36 / 0.64 (min / median / max of the paper's 73.3 m; 3.4x between phases),
+    converged after 16.0-30.3 days (paper 30). The LEO (15.4-19.0 m, 0.68 / 0.73 / 0.84x of 22.6 m) and the clock
+    (10.5-16.7 ns, 0.23 / 0.28 / 0.36x of 46.6 ns) less. The shipped Simu. 9 (DOWR every 24 h, 5x the paper's
+    rate) gives the DRO 9.8 m, below the whole range. Tolerance: the LEO within the factor 2 of the other Table 13
+    comparisons at every phase; the DRO below the paper at every phase (recorded disagreement, by how much depends
+    on the phase); the clock about 3x better (recorded: the truth clock's random walk between passes)."""
+    ratios = _alternation_ratios()
+    assert sorted(ALTERNATION["first_h"].astype(float)) == [0.0, 6.0, 24.0, 48.0, 72.0, 96.0]
+    assert np.all((0.5 < ratios["LEO_pos_m"]) & (ratios["LEO_pos_m"] < 2.0))
+    assert np.all(ratios["DRO_pos_m"] < 1.0) and ratios["DRO_pos_m"].max() / ratios["DRO_pos_m"].min() > 3.0
+    assert np.all(ratios["clock_ns"] < 0.5)
+    assert ALTERNATION["DRO_pos_m"].astype(float).min() > float(TABLE13["Simu. 9"][0])   # the 24-h plan's 9.8 m
+    conv = ALTERNATION["DRO_converge_d"].astype(float)
+    assert np.all((conv > 15.0) & (conv <= 30.5))

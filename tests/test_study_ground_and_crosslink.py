@@ -11,8 +11,9 @@ the other schedules need the whole run (``ODPIPE_STUDY_RUNS=1``, tests/study_run
 Tolerance for agreement: a factor 2. The thesis quotes rounded figures ("about 70 m", "on the order of
 10 m") and does not give the correlation time of its empirical accelerations; odpipe takes 1 day, and
 with 3 h the ground-only halo figure moves to 0.44x of the thesis', outside the bound: the agreement
-depends on that choice. The whole run refits the three default schedules over correlation times of
-3 h to 3 d and reports the spread of odpipe/thesis (``tau_spread``)."""
+depends on that choice. The whole run refits every case with a thesis figure over correlation times of
+3 h to 3 d and reports the spread of odpipe/thesis (``tau_spread``); the figures are stored in
+fixtures/studies/ground_and_crosslink_tau.csv and the spread is checked on them."""
 
 from pathlib import Path
 
@@ -27,8 +28,9 @@ from odpipe.frames.earth import gcrs_to_itrs_state
 from odpipe.studies import ground_and_crosslink as ground
 from odpipe.studies import schedule_trade
 from odpipe.studies.scenarios import load_config
+from odpipe.studies.study_report import spread
 from odpipe.time import utc_to_tdb
-from study_runs import as_recorded, run_study, whole_run
+from study_runs import as_recorded, run_study, stored_figures, whole_run
 
 CFG = load_config(Path(__file__).parents[1] / "runs" / "study_ground_and_crosslink.toml")
 CASES = ("ground", "ground_liaison", "liaison")   # (inf, 0), (0, 0) and (0, inf) of the thesis' Fig. 8.4/8.5
@@ -275,3 +277,70 @@ def test_whole_run_geo_ground_only_and_the_correlation_time():
                                                                      ("30.8", "34.9", "35.8", "34.2")]
     assert halo.loc[3.0, "odpipe/thesis"] < 0.5 < halo.loc[24.0, "odpipe/thesis"]
     assert [geo[f"tau {h} h"] for h in (12, 72)] == [as_recorded("351"), as_recorded("350")]
+
+
+# odpipe's thesis figures per correlation time of the empirical accelerations (the thesis gives none), every case
+# with a thesis figure, as fixtures/studies/ground_and_crosslink_tau.csv records them from a whole run
+TAU = stored_figures("ground_and_crosslink_tau")
+PAPER_KEY = {"3s RMS d6-9": "rms_sig3", "final 3s": "final_sig3", "day 3s<100 m": "below100_d"}
+
+
+def _tau_ratios() -> dict:
+    """(case, spacecraft, figure) -> {tau h: odpipe/thesis} of the stored figures."""
+    out = {}
+    for r in TAU.itertuples():
+        thesis = CFG["paper"][r.case][f"{r.spacecraft}_{PAPER_KEY[r.figure]}"]
+        out.setdefault((r.case, r.spacecraft, r.figure), {})[float(r.tau_h)] = float(r.odpipe) / thesis
+    return out
+
+
+@whole_run
+@pytest.mark.realdata
+def test_whole_run_correlation_time_figures_as_stored():
+    """The whole run's figures per correlation time equal the stored ones to their recorded digits."""
+    tau = run_study("study_ground_and_crosslink")["tau_cases"]
+    got = {(r["case"], r["spacecraft"], r["figure"], r["tau h"]): r["odpipe"] for _, r in tau.iterrows()}
+    for r in TAU.itertuples():
+        assert got[(r.case, r.spacecraft, r.figure, float(r.tau_h))] == as_recorded(r.odpipe), r
+
+
+@pytest.mark.slow
+@pytest.mark.realdata
+def test_crosslinks_only_at_a_3_h_correlation_time_as_stored(scenario):
+    """A fast check on the stored spread: crosslinks only refitted with a 3-h correlation time on the default
+    suite's set-up gives the stored figures (relative 1e-3, the snapshots' tolerance: the run is seeded)."""
+    cfg_tau = dict(CFG, filter=dict(CFG["filter"], acc_tau_s=3 * 3600.0))
+    m = ground.fit_schedule(CFG, scenario["sim"], CFG["cases"]["liaison"], cfg_tau)["metrics"]
+    stored = {r.spacecraft: float(r.odpipe) for r in TAU.itertuples() if r.case == "liaison" and float(r.tau_h) == 3.0}
+    for sc in ground.NAMES:
+        assert m[sc]["rms_sig3"] == pytest.approx(stored[sc], rel=1e-3), sc
+
+
+def test_stored_correlation_time_spread_against_the_thesis():
+    """The thesis does not give its empirical accelerations' correlation time; the stored figures at 3 h, 12 h, 1 d
+    and 3 d (the (0, 72), (72, 0) and (9, 69) schedules without 12 h) say which figures depend on it (odpipe/thesis,
+    min / median / max):
+
+    - none moves more than 1.5x over the range: most with the halo, crosslinks only (1.43-1.50x), ground +
+      crosslinks' final halo (1.43x) and (9, 69)'s halo (1.38x); the GEO figures 1.0-1.3x, the days below 100 m
+      1.0-1.2x. The 3-h correlation time gives the smallest uncertainties;
+    - crosslinks only is 2.5-4.5x tighter than the thesis whatever the choice (halo 0.22 / 0.29 / 0.31x of 160 m,
+      GEO 0.26 / 0.31 / 0.34x of 24 m; twice a day: GEO 0.31 / 0.37 / 0.40x of 30 m, the halo 44-66 m under the
+      thesis' "< 200 m"): that disagreement is not the correlation time's;
+    - every other schedule stays within the factor 2 at every correlation time: ground + crosslinks' final halo
+      1.26 / 1.73 / 1.80x of "on the order of 10 m", GEO 0.84 / 0.94 / 0.97x; (9, 69) 0.72-1.00x; sparse
+      0.55-1.09x; (0, 72) and (72, 0) days below 100 m 1.03-1.79x; the ground-only halo falls outside it at 3 h
+      (0.44x), as recorded before. Tolerance: the factor 2 of the module docstring."""
+    ratios = _tau_ratios()
+    spreads = {key: spread(list(by_tau.values())) for key, by_tau in ratios.items()}
+    assert {len(by_tau) for by_tau in ratios.values()} == {3, 4} and len(ratios) == 17
+    for key, s in spreads.items():
+        assert s["ratio max"] / s["ratio min"] < 1.6, key
+    for case in ("liaison", "liaison_2_per_day"):
+        assert spreads[(case, "GEO", "3s RMS d6-9")]["ratio max"] < 0.5, case
+    assert spreads[("liaison", "L1", "3s RMS d6-9")]["ratio max"] < 0.5
+    assert spreads[("liaison_2_per_day", "L1", "3s RMS d6-9")]["ratio max"] < 1.0      # thesis: "< 200 m"
+    for key in [k for k in spreads if k[0] not in ("ground", "liaison", "liaison_2_per_day")]:
+        assert 0.5 < spreads[key]["ratio min"] and spreads[key]["ratio max"] < 2.0, key
+    halo_ground = ratios[("ground", "L1", "3s RMS d6-9")]
+    assert halo_ground[3.0] < 0.5 < halo_ground[24.0]

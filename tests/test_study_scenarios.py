@@ -71,7 +71,7 @@ def test_malformed_toml_names_the_file_and_line(tmp_path):
 
 def test_every_shipped_scenario_configuration_loads():
     paths = sorted(RUNS.glob("study_*.toml"))
-    assert len(paths) == 7
+    assert len(paths) == 8
     for path in paths:
         assert load_config(path)["scenario"] in KINDS, path
 

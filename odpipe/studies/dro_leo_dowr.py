@@ -15,8 +15,9 @@ error is a Gauss-Markov process of sigma 20 ns (the paper's 1 sigma) whose corre
 the paper does not give. Each satellite's pseudorange (eq. 2) gets 0.5-m white thermal noise
 and the equipment delay; the sum combination (eq. 3) keeps the geometry and the delay
 D_com/2, the difference (eq. 5) the clock offset relative to the LEO (eq. 9, D_sub = 0 here).
-Data: 1 h of pseudoranges every 12 h (DOWR) or 120 h (the DOWR part of Simu. 9), one per
-``sample_s``, the link through the Earth removed (Fig. 2).
+Data: 1 h of pseudoranges every 12 h (DOWR or one-way ranging; Simu. 9: one-way every 12 h and DOWR
+every 24 h, or 120 h as the paper says, in study_dro_leo_dowr_alternation.toml), one per ``sample_s``,
+the link through the Earth removed (Fig. 2).
 
 Filter: odpipe's iterated filter-smoother (:func:`odpipe.estimation.fit.fit`) over
 :class:`DowrProblem`; estimated: both states, the DRO clock (c a0 as a random walk with the
@@ -54,7 +55,7 @@ from odpipe.time import utc_to_tdb
 from parsers.table import build
 
 from .halo_geo_doppler import link_clear
-from .study_report import plot_convergence, write_markdown, write_table
+from .study_report import plot_convergence, spread, write_markdown, write_table
 
 DAY = SECONDS_PER_DAY
 NAMES = ("DRO", "LEO")
@@ -78,8 +79,10 @@ DIFFERENCES = """\
   accelerations held over ``batch_s`` with the same velocity-variance rate, so Simu. 4's 1e-8 m/s^2
   per 5-min step gives the DRO 22x Simu. 2's; the DRO clock offset gets a random walk of the truth's
   level (the paper holds its clock parameters constant in the time update).
-- Simu. 9: the paper does not say how DOWR and one-way passes alternate; here every other 12-h pass
-  is DOWR.
+- Simu. 9: the paper gives one-way ranging 1 h every 12 h and DOWR 1 h every 120 h (sec. 2.2 (3)), not where
+  the DOWR pass falls in the 120-h cycle nor whether it takes a one-way pass's place. study_dro_leo_dowr.toml
+  has DOWR on every other 12-h pass (24 h, 5x the paper's DOWR rate); study_dro_leo_dowr_alternation.toml
+  runs 120 h at six phases (``first_h``) and reports the spread (``variant_of``).
 - Models: DE440 (paper DE405), GGM02C (GGM01C) and LP165P (GL0120B); what matters is the truth-minus-
   filter truncation (70 -> 50 and 20 -> 15 in Model-B), which is kept.
 - Not given in the paper, chosen here: the LEO time error's correlation time, the clock a0, the delay,
@@ -174,11 +177,12 @@ class DowrProblem(TrackingProblem):
 
 
 # -- simulation ---------------------------------------------------------------------------------
-def pass_epochs(cfg, every_h: float) -> np.ndarray:
-    """UTC reception epochs: ``pass_s`` of samples every ``sample_s`` at the start of every ``every_h`` hours."""
+def pass_epochs(cfg, every_h: float, first_h: float = 0.0) -> np.ndarray:
+    """UTC reception epochs: ``pass_s`` of samples every ``sample_s`` at the start of every ``every_h`` hours
+    from ``first_h`` past the epoch."""
     start = np.datetime64(cfg["epoch_utc"], "ns")
     sample = np.arange(cfg["sample_s"], cfg["pass_s"] + 1e-9, cfg["sample_s"])
-    starts = np.arange(0.0, cfg["arc_days"] * DAY - cfg["pass_s"], every_h * 3600.0)
+    starts = np.arange(first_h * 3600.0, cfg["arc_days"] * DAY - cfg["pass_s"], every_h * 3600.0)
     sec = (starts[:, None] + sample[None, :]).ravel()
     return start + (sec * 1e9).astype("timedelta64[ns]")
 
@@ -222,7 +226,7 @@ def simulate(cfg, meas, truth, clocks: ClockTruth, plan: list[dict], rng) -> tup
     c = cfg["clock"]
     by_epoch: dict = {}
     for item in plan:                       # DOWR passes replace one-way passes at the same epochs
-        for e in pass_epochs(cfg, item["every_h"]):
+        for e in pass_epochs(cfg, item["every_h"], item.get("first_h", 0.0)):
             if by_epoch.get(e) != "dowr":
                 by_epoch[e] = item["type"]
     epochs = np.array(sorted(by_epoch), dtype="datetime64[ns]")
@@ -394,6 +398,27 @@ def _quiet(*_):
     pass
 
 
+def variant_spread(sims: list[dict], results: dict) -> pd.DataFrame:
+    """Per simulation that others are ``variant_of`` (a choice the paper leaves open, e.g. where the DOWR
+    passes fall): each Table 13 figure over the variants, odpipe's min / median / max beside the paper's and the
+    spread of odpipe/paper."""
+    groups: dict[str, list[dict]] = {}
+    for sim in sims:
+        if sim.get("variant_of"):
+            groups.setdefault(sim["variant_of"], []).append(sim)
+    rows = []
+    for name, members in groups.items():
+        paper = members[0]["paper"]
+        for figure, ref, get in (("DRO pos [m]", paper["DRO"]["pos_m"], lambda a: a["DRO"]["pos"]),
+                                 ("LEO pos [m]", paper["LEO"]["pos_m"], lambda a: a["LEO"]["pos"]),
+                                 ("clock [ns]", paper["clock_ns"], lambda a: a["clock_ns"])):
+            got = np.array([get(results[m["name"]]) for m in members])
+            rows.append({"simulation": name, "variants": len(members), "figure": figure, "paper": ref,
+                         "odpipe min": got.min(), "odpipe median": float(np.median(got)), "odpipe max": got.max(),
+                         **spread(got / ref)})
+    return pd.DataFrame(rows)
+
+
 def run(cfg: dict, out, log=print) -> dict:
     """Every ``[[simulation]]`` (on a local Dask cluster with ``parallel = true``, the CLI's
     ``--parallel``), then the Table 13 report."""
@@ -443,8 +468,11 @@ def run(cfg: dict, out, log=print) -> dict:
                          f"delay {c['delay_m']} m)" for name, r in results.items())
              + "\n- one-way ranging alone cannot tell the delay from the DRO clock offset (both enter every "
                "row alike): their split rests on the a priori")
+    variants = variant_spread(sims, results)
+    spread_section = ([("Choices the paper leaves open: spread over the variants (min / median / max)",
+                        write_table(out, "variant_spread", variants))] if len(variants) else [])
     write_markdown(out, "Study dro_leo_dowr: DRO-LEO dual one-way ranging (Li et al., Table 13)",
                    [("Table 13: 3-D RMS over the last 8 days, paper vs odpipe",
                      write_table(out, "table13", table) + "\n![position](position.png)\n\n![clock](clock.png)\n"),
-                    ("Set-up", notes + "\n"), ("Differences from the paper's set-up", DIFFERENCES)])
-    return {"table": table, "results": results}
+                    *spread_section, ("Set-up", notes + "\n"), ("Differences from the paper's set-up", DIFFERENCES)])
+    return {"table": table, "results": results, "variant_spread": variants}

@@ -283,13 +283,14 @@ FIGURES = ("3s RMS d6-9", "final 3s", "day 3s<100 m")
 
 
 def tau_spread(cfg, sim: dict, log=print) -> tuple[pd.DataFrame, pd.DataFrame]:
-    """The ``sensitivity.cases`` refitted with each correlation time ``sensitivity.acc_tau_s`` (the thesis
+    """The ``sensitivity.tau_cases`` refitted with each correlation time ``sensitivity.acc_tau_s`` (the thesis
     gives none): every thesis figure with odpipe's beside it per correlation time, and per figure the
-    spread of odpipe/thesis over them (with the correlation times of its ends)."""
+    spread of odpipe/thesis over them (with the correlation times of its ends) and of odpipe's figure
+    (max/min: how sensitive it is to the choice)."""
     sens, rows = cfg["sensitivity"], []
     for tau in sens["acc_tau_s"]:
         cfg_tau = dict(cfg, filter=dict(cfg["filter"], acc_tau_s=tau))
-        for name in sens["cases"]:
+        for name in sens["tau_cases"]:
             case = cfg["cases"][name]
             m = fit_schedule(cfg, sim, case, cfg_tau)["metrics"]
             log(f"{name}, correlation time {tau / 3600:g} h: "
@@ -304,6 +305,7 @@ def tau_spread(cfg, sim: dict, log=print) -> tuple[pd.DataFrame, pd.DataFrame]:
     for (name, sc, fig), g in df.groupby(["case", "spacecraft", "figure"], sort=False):
         ratio = g["odpipe/thesis"].to_numpy()
         summary.append({"case": name, "spacecraft": sc, "figure": fig, "thesis": g["thesis"].iloc[0], **spread(ratio),
+                        "max/min": float(ratio.max() / ratio.min()),
                         "tau h at min": g["tau h"].iloc[int(np.argmin(ratio))],
                         "tau h at max": g["tau h"].iloc[int(np.argmax(ratio))]})
     return df, pd.DataFrame(summary)
@@ -415,7 +417,7 @@ def run(cfg: dict, out, log=print, sim: dict | None = None) -> dict:
                                       ("3-D 3-sigma", m[sc]["sig3"], {"color": "k", "ls": ":"})]})
     df = pd.DataFrame(table)
     spread_sections, tau_rows, tau_summary, geo = [], None, None, None
-    if sens["acc_tau_s"] and sens["cases"]:
+    if sens["acc_tau_s"] and sens["tau_cases"]:
         tau_rows, tau_summary = tau_spread(cfg, sim, log)
         spread_sections.append(("Correlation time of the empirical accelerations (not in the thesis): spread of "
                                 "odpipe/thesis", write_table(out, "tau_spread", tau_summary) + "\n"

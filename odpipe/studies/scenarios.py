@@ -414,10 +414,11 @@ class DowrModel:
 
 @section
 class LinkPlan:
-    """An entry of ``plan``: links of one type, one pass every ``every_h`` hours."""
+    """An entry of ``plan``: links of one type, one pass every ``every_h`` hours from ``first_h``."""
 
     type: Literal["dowr", "oneway"]  # dual one-way ranging or one-way ranging
     every_h: float = checked(positive)  # h
+    first_h: float = checked(_at_least_zero, default=0.0)  # h past the epoch, start of the first pass
 
 
 @section
@@ -453,6 +454,7 @@ class DowrSimulation:
     max_iter: int | None = None  # iterations per stage (default: the top-level one)
     final_iter: int | None = None  # iterations on the whole arc (default: the top-level one)
     paper: SimulationPaper  # the paper's Table 13 row
+    variant_of: str | None = None  # the Table 13 simulation whose open choice this one varies (spread reported)
 
 
 @section
@@ -584,8 +586,9 @@ class Sensitivity:
     """Cases refitted with the filter's accelerations scaled, and over the choices the thesis leaves open."""
 
     acc_scale: float = checked(positive)  # factor on acc_sigma_rtn
-    cases: list[str] = field(default_factory=list)  # the [cases.X] names refitted
-    acc_tau_s: list[float] = checked(positive, default_factory=list)  # s, correlation times these cases are refitted with
+    cases: list[str] = field(default_factory=list)  # the [cases.X] names refitted with the accelerations scaled
+    acc_tau_s: list[float] = checked(positive, default_factory=list)  # s, correlation times tau_cases are refitted with
+    tau_cases: list[str] = field(default_factory=list)  # the [cases.X] names refitted over acc_tau_s
     geo_apriori_vel_mps: list[float] = checked(positive, default_factory=list)  # m/s, "ground" refitted with these
 
 
