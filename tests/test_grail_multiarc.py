@@ -112,3 +112,22 @@ def test_a_multiarc_config_names_what_is_wrong(tmp_path):
     cfg.write_text('[multiarc]\nname = "m"\narcs = ["a.toml", "b.toml"]\nshared = ["srp_scale"]\nrounds = 2\n')
     sec = load_multiarc(cfg)
     assert sec.arcs == [tmp_path / "a.toml", tmp_path / "b.toml"] and sec.rounds == 2
+
+
+def test_the_multiarc_command_refuses_bad_configs_and_arcs_not_yet_run(tmp_path, capsys):
+    """``odpipe multiarc``: a wrong config and arcs without a complete run are one line each, exit status 2."""
+    from odpipe.cli import main
+    from test_cli_batch import arc_text
+
+    bad = tmp_path / "bad.toml"
+    bad.write_text('[multiarc]\nname = "m"\narcs = ["a.toml"]\nshared = ["mass"]\n')
+    assert main(["multiarc", str(bad)]) == 2
+    err = capsys.readouterr().err.strip()
+    assert len(err.splitlines()) == 1 and "multiarc.arcs" in err and "'mass'" in err and "Traceback" not in err
+    for name in ("a", "b"):
+        (tmp_path / f"{name}.toml").write_text(arc_text(name))
+    good = tmp_path / "m.toml"
+    good.write_text('[multiarc]\nname = "m"\narcs = ["a.toml", "b.toml"]\nshared = ["srp_scale"]\n')
+    assert main(["multiarc", str(good)]) == 2
+    err = capsys.readouterr().err.strip()
+    assert len(err.splitlines()) == 1 and "a.toml" in err and "run this arc first" in err
