@@ -57,14 +57,14 @@ def multiarc(out: Path, arcs=DAILY, shared=("srp_scale",)) -> list[dict]:
     arcs = ", ".join(f'"{out / "base" / "configs" / f"{a}.toml"}"' for a in names)
     cfg.write_text(f'[multiarc]\nname = "runs"\noutput = "{folder}"\narcs = [{arcs}]\n'
                    f'shared = [{", ".join(repr(s).replace(chr(39), chr(34)) for s in shared)}]\nrounds = 1\n')
-    done = all((folder / "runs" / a / "trajectory.oem").exists() for a in names)
+    done = all((folder / "runs" / "current" / a / "trajectory.oem").exists() for a in names)
     if not done:
         result = run_multiarc(cfg)
         print(result["shared"].to_string(index=False), flush=True)
     label = folder.name
-    rows = [{"solution": label, "arc": a, **station_rms(folder / "runs" / a / "residuals.parquet")} for a in names]
+    rows = [{"solution": label, "arc": a, **station_rms(folder / "runs" / "current" / a / "residuals.parquet")} for a in names]
     oem = {a: out / "base" / a / "current" / "trajectory.oem" for a in DAILY}   # the nightly's, where not refitted
-    oem.update({a: folder / "runs" / a / "trajectory.oem" for a in names})
+    oem.update({a: folder / "runs" / "current" / a / "trajectory.oem" for a in names})
     for a, b in zip(DAILY[:-1], DAILY[1:]):
         if a in names or b in names:
             rows.append({"solution": label, **overlap(oem[a], oem[b], f"{a[-5:]} - {b[-5:]}")})

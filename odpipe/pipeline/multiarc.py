@@ -11,7 +11,8 @@ The configuration (TOML)::
 
 Every arc must have a complete run (``odpipe run``/``batch``): its edited tracking table
 (``tracking.parquet``) is fitted again, and its ``solution.npz`` is the first round's estimate
-(:func:`odpipe.od.multiarc.fit_multiarc`). Products in ``OUTPUT/NAME``: ``shared.csv`` (each arc's own
+(:func:`odpipe.od.multiarc.fit_multiarc`). Products go to a new attempt folder under ``OUTPUT/NAME`` that becomes ``OUTPUT/NAME/current`` only when
+every file is written (:mod:`odpipe.operations.rundir`, as ``odpipe run``): ``shared.csv`` (each arc's own
 estimate, its consistency chi-square and the combination) and per arc ``<arc>/trajectory.oem``,
 ``residuals.parquet``, ``parameters.csv`` of the fit with the shared parameters fixed.
 """
@@ -28,6 +29,7 @@ import pandas as pd
 from odpipe.estimation.solution import Solution
 from odpipe.od.arc import build_registry
 from odpipe.od.multiarc import _SIGMA_FIELD, fit_multiarc, solution_share
+from odpipe.operations import rundir
 from odpipe.operations.schema import ConfigError, at_least, checked, file_name, load, positive, read_toml
 from odpipe.pipeline import setup as build
 from odpipe.pipeline.config import load_config
@@ -71,6 +73,7 @@ class _Arc:
     table: pd.DataFrame
     setup: object
     share: object = field(default=None)
+    inputs: tuple = ()
 
 
 def _arc(path: Path, shared) -> _Arc:
@@ -90,7 +93,7 @@ def _arc(path: Path, shared) -> _Arc:
     idx = [reg.index(n) for n in names]
     share = solution_share(Solution.load(run / "solution.npz"), setup.spacecraft, shared,
                            reg.apriori[idx], reg.sigma[idx])
-    return _Arc(cfg, table, setup, share)
+    return _Arc(cfg, table, setup, share, (path, run / "solution.npz", run / "tracking.parquet"))
 
 
 def run_multiarc(path, log=print) -> dict:
@@ -99,21 +102,30 @@ def run_multiarc(path, log=print) -> dict:
     arcs = [_arc(p, sec.shared) for p in sec.arcs]
     sol = fit_multiarc([(a.table, a.setup) for a in arcs], sec.shared, rounds=sec.rounds,
                        first=[a.share for a in arcs], log=log)
-    out = sec.output / sec.name
-    out.mkdir(parents=True, exist_ok=True)
-    table = sol.shared.table([a.cfg.run.name for a in arcs])
-    write_text(out / "shared.csv", table.to_csv(index=False))
-    for a, fitted in zip(arcs, sol.arcs):
-        folder = out / a.cfg.run.name
-        folder.mkdir(exist_ok=True)
-        write_oem(folder / "trajectory.oem", fitted_segments(fitted, sec.step),
-                  a.cfg.products.object_name or a.cfg.arc.spacecraft, a.cfg.arc.spacecraft,
-                  comments=[f"odpipe multi-arc {sec.name}: {a.cfg.run.name} with {', '.join(sec.shared)} "
-                            f"fixed at the combination"])
-        write_parquet(folder / "residuals.parquet", fitted.residuals)
-        write_text(folder / "parameters.csv", parameters.with_units(fitted.parameters).to_csv(index=False))
-        write_text(folder / "summary.json", json.dumps({"converged": bool(fitted.converged),
-                                                        "iterations": len(fitted.history)}))
-        log(f"multi-arc {sec.name}: {a.cfg.run.name} {'converged' if fitted.converged else 'NOT converged'}")
+    attempt = rundir.start(sec.output / sec.name)
+    try:
+        table = sol.shared.table([a.cfg.run.name for a in arcs])
+        write_text(attempt.product("shared.csv"), table.to_csv(index=False))
+        for a, fitted in zip(arcs, sol.arcs):
+            _write_arc(attempt, sec, a, fitted)
+            log(f"multi-arc {sec.name}: {a.cfg.run.name} {'converged' if fitted.converged else 'NOT converged'}")
+    except BaseException as exc:
+        attempt.fail(exc)
+        raise
+    inputs = [Path(path).resolve()] + [p for a in arcs for p in a.inputs]
+    attempt.finish(rundir.fingerprint(Path(path).read_text(), inputs))
+    out = sec.output / sec.name / "current"
     return {"shared": table, "folder": str(out), "converged": [bool(f.converged) for f in sol.arcs],
             "rounds": [np.asarray(c.estimate).tolist() for c in sol.rounds]}
+
+
+def _write_arc(attempt, sec: MultiArcSection, a: _Arc, fitted) -> None:
+    """One arc's products of the multi-arc fit, in ``<arc>/`` of the attempt."""
+    name = a.cfg.run.name
+    write_oem(attempt.product(f"{name}/trajectory.oem"), fitted_segments(fitted, sec.step),
+              a.cfg.products.object_name or a.cfg.arc.spacecraft, a.cfg.arc.spacecraft,
+              comments=[f"odpipe multi-arc {sec.name}: {name} with {', '.join(sec.shared)} fixed at the combination"])
+    write_parquet(attempt.product(f"{name}/residuals.parquet"), fitted.residuals)
+    write_text(attempt.product(f"{name}/parameters.csv"), parameters.with_units(fitted.parameters).to_csv(index=False))
+    write_text(attempt.product(f"{name}/summary.json"), json.dumps({"converged": bool(fitted.converged),
+                                                                  "iterations": len(fitted.history)}))
