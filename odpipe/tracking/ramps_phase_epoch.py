@@ -1,0 +1,30 @@
+"""An instant a fixed time into the uplink ramp record in force at each row's tag.
+
+MESSENGER's odf07155 has range passes whose points read the uplink phase not at reception but 599 s into
+the 20-min ramp record holding the tag (when the tag is that late in it): the ``uplink_epoch`` that
+:func:`odpipe.measurements.dsn.dsn_range` accepts (docs/validation.md, MESSENGER).
+"""
+
+from __future__ import annotations
+
+import numpy as np
+import pandas as pd
+
+
+def into_segment(ramps: pd.DataFrame, station, epochs, seconds: float) -> np.ndarray:
+    """UTC datetime64[ns] per row: ``seconds`` (s) after the start of ``station``'s ramp record covering
+    ``epochs``; NaT where the tag comes earlier than that in its record or no record covers it."""
+    station = np.broadcast_to(np.asarray(station, dtype=object), np.shape(epochs))
+    t = np.asarray(epochs, dtype="datetime64[ns]")
+    out = np.full(t.shape, np.datetime64("NaT"), dtype="datetime64[ns]")
+    step = np.timedelta64(int(round(seconds * 1e9)), "ns")
+    for st in np.unique(station):
+        g = ramps[ramps["station"] == st].sort_values("start", kind="stable")
+        start, end = g["start"].to_numpy("datetime64[ns]"), g["end"].to_numpy("datetime64[ns]")
+        mine = np.flatnonzero(station == st)
+        k = np.searchsorted(start, t[mine], side="right") - 1
+        ok = k >= 0
+        at = np.where(ok, start[np.maximum(k, 0)] + step, np.datetime64("NaT"))
+        ok &= (t[mine] < end[np.maximum(k, 0)]) & (at <= t[mine])
+        out[mine[ok]] = at[ok]
+    return out
