@@ -100,8 +100,8 @@ def test_range_records_decode_as_the_spec_defines_them(data):
 def test_drvid_keeps_the_first_dss63_pass_and_rejects_the_others(data):
     """DRVID between consecutive range points: DSS-63's 06-04 pass within 10 RU (measured |d| <= 8 RU, 1.1 m);
     in the other three passes every pair misses by more than 1e3 RU (a random value would be within 1e3 RU
-    with probability 0.002): their range does not follow the spacecraft, and the run config removes exactly
-    those passes' range."""
+    with probability 0.002): their range is not the plain definition, and the run config reads exactly those
+    passes' range by ``[[preprocess.range_uplink_epoch]]`` (the test below)."""
     d, store, rng = data
     rows = []
     for p, g in rng.groupby("pass"):
@@ -115,30 +115,34 @@ def test_drvid_keeps_the_first_dss63_pass_and_rejects_the_others(data):
     assert out.loc[good, "drvid"].abs().max() < 10.0
     assert (out.loc[~good, "drvid"].abs() > 1e3).all() and out.loc[~good, "pass"].nunique() == 3
     cfg = tomllib.loads((RUNS / "messenger_2007_06_04.toml").read_text())
-    removed = np.zeros(len(rng), bool)
-    for w in cfg["preprocess"]["edit_windows"]:
-        assert w["observable"] == "range" and w["reason"]
-        removed |= ((rng["station_rx"] == w["station_rx"]) & (rng["epoch"] >= pd.Timestamp(w["start"]))
-                    & (rng["epoch"] <= pd.Timestamp(w["end"]))).to_numpy()
-    np.testing.assert_array_equal(removed, (rng["pass"] != 1).to_numpy())
+    assert "edit_windows" not in cfg["preprocess"]
+    read = np.zeros(len(rng), bool)
+    for w in cfg["preprocess"]["range_uplink_epoch"]:
+        assert w["reason"] and w["into_ramp_s"] == STALE_S
+        read |= ((rng["station_rx"] == w["station_rx"]) & (rng["epoch"] >= pd.Timestamp(w["start"]))
+                 & (rng["epoch"] <= pd.Timestamp(w["end"]))).to_numpy()
+    np.testing.assert_array_equal(read, (rng["pass"] != 1).to_numpy())  # the run reads exactly those passes so
 
 
 @pytest.mark.realdata
-def test_edit_windows_need_a_reason_and_an_order(tmp_path, shared_data):
+def test_uplink_epoch_sections_need_a_reason_and_an_order(tmp_path, shared_data):
     import re
 
     from odpipe.operations.schema import ConfigError
     from odpipe.pipeline.config import load_config
 
     text = re.sub(r'"\.\./\.\./shared/data/', f'"{shared_data}/', (RUNS / "messenger_2007_06_04.toml").read_text())
-    text = re.sub(r'^reason = ".*"$', 'reason = " "', text, count=1, flags=re.M)  # the first window's
+    text = re.sub(r'^reason = ".*"$', 'reason = " "', text, count=1, flags=re.M)  # the first section's
     text = text.replace('end = "2007-06-05T05:00:00"', 'end = "2007-06-04T19:00:00"', 1)
     (tmp_path / "arc.toml").write_text(text)
     with pytest.raises(ConfigError) as err:
         load_config(tmp_path / "arc.toml")
     msg = str(err.value)
-    assert "preprocess.edit_windows[0].reason" in msg and "say why the rows are removed" in msg
-    assert "preprocess.edit_windows[0].end" in msg and "before the start" in msg
+    assert "preprocess.range_uplink_epoch[0].reason" in msg and "say why the rows are removed" in msg
+    assert "preprocess.range_uplink_epoch[0].end" in msg and "before the start" in msg
+    (tmp_path / "arc.toml").write_text(text.replace("into_ramp_s = 599.0", "into_ramp_s = -1.0", 1))
+    with pytest.raises(ConfigError, match=r"preprocess\.range_uplink_epoch\[0\]\.into_ramp_s\] -1\.0 must be positive"):
+        load_config(tmp_path / "arc.toml")
 
 
 @pytest.mark.realdata
@@ -151,7 +155,7 @@ def test_the_failing_passes_take_the_uplink_phase_599_s_into_the_ramp_segment(da
     plain reading misses by 1e4-5e5 RU (test above). The points earlier in their records (22) are not explained.
     The good pass (DSS-63 06-04) does not follow the rule: its late points (1052 s into their records) miss by
     more than 1e4 RU under it (measured 1.16e5-1.61e5). Against the fitted orbit with the good pass's bias the rule
-    leaves <= 4 RU on the 20 late points (docs/validation.md, benchmarks/messenger_stale_range.py)."""
+    leaves <= 4 RU on the 20 late points (docs/validation.md; the run fits them)."""
     d, store, rng = data
     late, good, early = [], [], 0
     for p, g in rng.groupby("pass"):

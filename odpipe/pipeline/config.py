@@ -173,6 +173,15 @@ class EditWindowSection:
 
 
 @dataclass
+class UplinkEpochSection(EditWindowSection):
+    """Range rows in the window read the uplink phase ``into_ramp_s`` s into the ramp record holding their tag
+    (``uplink_epoch``, :func:`odpipe.measurements.dsn.dsn_range`); rows tagged earlier in their record are
+    removed (flag USER). ``reason`` says what shows it (MESSENGER odf07155: docs/validation.md)."""
+
+    into_ramp_s: float = checked(positive, default=599.0)  # s after the ramp record's start
+
+
+@dataclass
 class PreprocessSection:
     count_time: float = checked(positive, default=60.0)  # s, Doppler compression target
     # compressed windows cut short (gaps, ramp segments): keep them, flag them, or drop them
@@ -183,6 +192,7 @@ class PreprocessSection:
     apriori_blunder_k: float | None = checked(positive, default=None)
     min_pass_samples: int = checked(at_least(1), default=10)  # passes with fewer rows are flagged SHORT_PASS
     edit_windows: list[EditWindowSection] = field(default_factory=list)  # analyst edits (flag USER), each with its reason
+    range_uplink_epoch: list[UplinkEpochSection] = field(default_factory=list)  # range read at a stale uplink phase
 
 
 @dataclass

@@ -28,3 +28,30 @@ def into_segment(ramps: pd.DataFrame, station, epochs, seconds: float) -> np.nda
         ok &= (t[mine] < end[np.maximum(k, 0)]) & (at <= t[mine])
         out[mine[ok]] = at[ok]
     return out
+
+
+def stale_uplink_range(table: pd.DataFrame, ramps: pd.DataFrame, sections) -> tuple[pd.DataFrame, tuple[int, int]]:
+    """Apply ``[[preprocess.range_uplink_epoch]]`` sections (start, end, station_rx, into_ramp_s) to ``table``.
+
+    Range rows in a section's window get ``uplink_epoch`` = :func:`into_segment` of their transmitter; those
+    tagged earlier in their ramp record are flagged USER. Returns the table and (rows removed, rows given an epoch).
+    """
+    from odpipe.preprocess.flags import Flag
+
+    out = table.copy()
+    if "uplink_epoch" not in out.columns:
+        out["uplink_epoch"] = np.full(len(out), np.datetime64("NaT"), dtype="datetime64[ns]")
+    epoch = out["epoch"].to_numpy("datetime64[ns]")
+    removed = read = 0
+    for w in sections:
+        mine = (out["observable"] == "range").to_numpy() & (epoch >= np.datetime64(w.start, "ns")) \
+            & (epoch <= np.datetime64(w.end, "ns"))
+        if w.station_rx:
+            mine &= (out["station_rx"] == w.station_rx).to_numpy()
+        idx = np.flatnonzero(mine)
+        at = into_segment(ramps, out["station_tx"].to_numpy(object)[idx], epoch[idx], w.into_ramp_s)
+        late = ~np.isnat(at)
+        out.loc[out.index[idx[late]], "uplink_epoch"] = at[late]
+        out.loc[out.index[idx[~late]], "flags"] = out["flags"].to_numpy()[idx[~late]] | int(Flag.USER)
+        removed, read = removed + int((~late).sum()), read + int(late.sum())
+    return out, (removed, read)
