@@ -10,6 +10,8 @@ from __future__ import annotations
 import numpy as np
 import pandas as pd
 
+from odpipe.preprocess.flags import Flag
+
 
 def into_segment(ramps: pd.DataFrame, station, epochs, seconds: float) -> np.ndarray:
     """UTC datetime64[ns] per row: ``seconds`` (s) after the start of ``station``'s ramp record covering
@@ -36,8 +38,6 @@ def stale_uplink_range(table: pd.DataFrame, ramps: pd.DataFrame, sections) -> tu
     Range rows in a section's window get ``uplink_epoch`` = :func:`into_segment` of their transmitter; those
     tagged earlier in their ramp record are flagged USER. Returns the table and (rows removed, rows given an epoch).
     """
-    from odpipe.preprocess.flags import Flag
-
     out = table.copy()
     if "uplink_epoch" not in out.columns:
         out["uplink_epoch"] = np.full(len(out), np.datetime64("NaT"), dtype="datetime64[ns]")
