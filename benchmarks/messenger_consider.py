@@ -7,8 +7,9 @@ estimated): DSN station ITRS coordinates (``STATION_M`` per axis), the media cal
 model troposphere, no TRK-2-23 cards), and the SRP scale held fixed instead of estimated (its estimate's shift of
 the state, in sigmas). Then the range's part: the same fit without the range, and with the range pass's bias
 a priori tightened from the run's 1 km (no delay calibration in the ODF) to what a calibrated station and
-transponder delay would give (``CALIBRATED_M``); and, as a covariance study, with the 42 edited range points of
-the other three passes replaced by the values the fitted orbit computes (what four good passes would give).
+transponder delay would give (``CALIBRATED_M``); and, as a covariance study, with the range points the run removes
+(USER: the 22 of the other three passes that follow no known reading) replaced by the values the fitted orbit
+computes (what four whole good passes would give).
 Run: ``python benchmarks/messenger_consider.py`` from the repository root (a few minutes).
 """
 
@@ -91,7 +92,7 @@ def main():
         arc = fit_arc(sim, replace(base, range_bias_sigma=b))
         p, v = _sigmas(arc.covariances[0])
         along, across = _los_split(arc.covariances[0], arc.states[0], fm, base.start)
-        print(f"four range passes (42 simulated points), bias a priori {b:g} m: position {p / 1e3:.2f} km "
+        print(f"four range passes ({int(edited.sum())} simulated points), bias a priori {b:g} m: position {p / 1e3:.2f} km "
               f"(x{p / p0:.3f}; along the line of sight {along / 1e3:.2f} km, across {across / 1e3:.2f} km), "
               f"velocity {v * 1e3:.1f} mm/s (x{v / v0:.3f})")
     print(plain.parameters.to_string())

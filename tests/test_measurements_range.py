@@ -70,6 +70,25 @@ def test_ramped_range_integrates_the_uplink_over_the_round_trip():
     np.testing.assert_allclose(r, 0.5 * ((f0 + rate * t1) * rho + rate * rho**2 / 2), rtol=1e-13)
 
 
+def test_range_read_at_another_uplink_epoch_integrates_from_t1_to_that_epoch():
+    """R = F integral(f_T, t1, s): a 10 Hz/s ramp read 300 s before reception (NaT rows: at reception)."""
+    traj, st = _scenario()
+    sol = _solve(traj, st, EPOCHS)
+    rate, f0, start = 10.0, F_S, T0 - np.timedelta64(1, "h")
+    ramps = RampStore(pd.DataFrame({"station": ["DSS-14"], "start": [start], "end": [T0 + np.timedelta64(10, "h")],
+                                    "freq_hz": [f0], "rate_hz_s": [rate], "band": ["S"], "source": ["t"], "record": [0]}))
+    s = EPOCHS - np.timedelta64(300, "s")
+    s[::2] = np.datetime64("NaT")
+    r = dsn_range(sol, ramps, "DSS-14", EPOCHS, 0.5, uplink_epoch=s)
+    rho = sol.clock_time
+    t1 = (EPOCHS - start).astype(np.int64) * 1e-9 - rho
+    span = np.where(np.isnat(s), rho, rho - 300.0)
+    np.testing.assert_allclose(r.value, 0.5 * ((f0 + rate * t1) * span + rate * span**2 / 2), rtol=1e-13)
+    plain = dsn_range(sol, ramps, "DSS-14", EPOCHS, 0.5)  # the orbit enters through t1 alone: same partials
+    for a, b in zip(r.events, plain.events):
+        np.testing.assert_array_equal(a.d_pos, b.d_pos)
+
+
 def test_range_partials_vs_finite_differences():
     traj, st = _scenario()
     up = ConstantUplink(F_S)

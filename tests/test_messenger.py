@@ -79,27 +79,33 @@ def test_doppler_fit_converges_within_its_sigma_per_station_and_pass(fitted):
 @pytest.mark.slow
 @pytest.mark.realdata
 def test_range_fits_at_its_noise_with_the_doppler(chain):
-    """DSS-63's 06-04 range pass (19 points, one estimated bias) fits at its noise: post-fit RMS under the 1-m
-    sigma (measured 0.31 m) and chi-square under its 99.9 % point; the Doppler keeps its per-pass RMS (0.02-0.48
-    mm/s); the 42 range points of the other passes are the configuration's analyst edits (test_messenger_range)."""
+    """Four range passes (one estimated bias each) fit at their noise: DSS-63's 06-04 pass (19 points, the plain
+    definition) and the 20 points of the other three passes that read the uplink phase 599 s into their ramp
+    record (DSS-14 8, DSS-43 3, DSS-63 06-05 9; test_messenger_range): every pass's post-fit RMS under the 1-m
+    sigma (measured 0.24-0.33 m), chi-square under its 99.9 % point, and the four biases equal within 1 m
+    (measured 223.65-223.79 m: one delay, as a shared station and transponder calibration would give); the
+    Doppler keeps its per-pass RMS (0.02-0.48 mm/s); the 22 points earlier in their records are removed (USER)."""
     out, cfg = chain["messenger_2007_06_04"]
     assert out["status"] == "complete" and out["converged"]
     run = Path(out["run"])
     passes = pd.read_csv(run / "residual_statistics_passes.csv")
     print(passes[["observable", "station_rx", "pass_id", "n_used", "postfit_mean", "postfit_rms", "los_unit"]])
     rng = passes[passes["observable"] == "range"]
-    assert list(rng["station_rx"]) == ["DSS-63"] and int(rng["n_used"].iloc[0]) == 19
-    assert float(rng["postfit_rms"].iloc[0]) < cfg.estimation.data_sigma["range"]
+    assert sorted(rng["n_used"]) == [3, 8, 9, 19] and set(rng["station_rx"]) == {"DSS-14", "DSS-43", "DSS-63"}
+    assert (rng["postfit_rms"] < cfg.estimation.data_sigma["range"]).all()
     dop = passes[passes["observable"] == "doppler_2way"]
     sig = cfg.estimation.data_sigma
     assert (dop["postfit_rms"] < dop["station_rx"].map(lambda st: sig.get(f"doppler_2way:{st}", sig["doppler_2way"]))).all()
     res = pd.read_parquet(run / "residuals.parquet")
     used = res[(res["flags"] == 0) & (res["observable"] == "range")]
     z = used["postfit"].to_numpy() / used["sigma"].to_numpy()  # row units (RU)
-    assert np.sum(z ** 2) < chi2.ppf(0.999, len(z) - 1)
+    assert np.sum(z ** 2) < chi2.ppf(0.999, len(z) - 4)
+    params = pd.read_csv(run / "parameters.csv")
+    bias = params.loc[params["name"].str.startswith("bias.range."), "estimate"]
+    assert len(bias) == 4 and np.ptp(bias) < 1.0
     tracking = pd.read_parquet(run / "tracking.parquet")
     edited = tracking[(tracking["observable"] == "range") & (tracking["flags"] & int(Flag.USER) != 0)]
-    assert len(edited) == 42 and "DSS-63" in set(edited["station_rx"]) and len(set(edited["station_rx"])) == 3
+    assert len(edited) == 22 and len(set(edited["station_rx"])) == 3
 
 
 @pytest.mark.slow
@@ -107,7 +113,7 @@ def test_range_fits_at_its_noise_with_the_doppler(chain):
 @pytest.mark.parametrize("name", ["messenger_2007_06_04_doppler", "messenger_2007_06_04"])
 def test_fitted_orbit_predicts_the_venus_flyby(chain, name):
     """The fitted orbit, propagated 2 h past the last data, passes Venus within 10 km and 60 s of the
-    published flyby (measured: Doppler only 338.0 km altitude at 23:08:18 UTC; Doppler + range 338.8 km at 23:08:19);
+    published flyby (measured: Doppler only 338.0 km altitude at 23:08:18 UTC; Doppler + range 338.4 km at 23:08:19, 338.8 km with the 06-04 range pass alone);
     orbits fitted at cm/s weights missed by 6 600 km, and the a priori (20 363 km from the centre at 22:53:29)
     by 14 000 km."""
     out, cfg = chain[name]

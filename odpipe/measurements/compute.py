@@ -251,7 +251,9 @@ def _dsn_two_way(grp: Group):
         delay = delay - 2.0 * setup.com_offsets.get(sc, 0.0) / C_LIGHT
         if grp.unit not in ("RU", "m", "s"):
             raise _Unsupported(f"range in unit {grp.unit!r}: only RU, m and s are modelled")
-        return dsn.dsn_range(grp.solve(nodes, grp.epoch), up, tx, grp.epoch, ru, grp.unit, delay, modulus), roles
+        read = g["uplink_epoch"].to_numpy("datetime64[ns]") if "uplink_epoch" in g.columns else None
+        return dsn.dsn_range(grp.solve(nodes, grp.epoch), up, tx, grp.epoch, ru, grp.unit, delay, modulus,
+                             read), roles
     m2 = g["transponder_ratio"].to_numpy(float)
     m2 = np.where(np.isfinite(m2), m2, turnaround_ratio(g["band_up"].to_numpy(object), g["band_down"].to_numpy(object)))
     s, e = grp.interval()

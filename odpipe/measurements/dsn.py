@@ -12,6 +12,9 @@ Conventions, all tested:
   uplink band (:mod:`.bands`), f_T the transmitter's uplink (ramped or
   constant), t1 = t3 - rho - delay (station plus transponder delay, s).
   In metres: ``R = c (rho + delay) / 2``; in seconds (ODF type 41): ``rho + delay``.
+  A row may read the uplink phase at an epoch s other than reception:
+  ``R = F * integral(f_T dt, t1, s) mod M`` (``uplink_epoch``; MESSENGER's
+  odf07155 has such passes, s = 599 s into the 20-min ramp segment of the tag).
   PN range uses the same range unit.
 * **Two/three-way Doppler** (Hz), count interval [t3s, t3e] of Tc s, turnaround M2:
   ``F = (M2/Tc) [integral(f_R, t3s, t3e) - integral(f_T, t1s, t1e)]``,
@@ -53,11 +56,13 @@ def _events(sols_and_gains) -> list[EventPartial]:
     return out
 
 
-def dsn_range(sol, uplink, station_tx, t3_utc, ru_factor, unit: str = "RU", delay_s=0.0, modulus=np.nan) -> Computed:
+def dsn_range(sol, uplink, station_tx, t3_utc, ru_factor, unit: str = "RU", delay_s=0.0, modulus=np.nan,
+              uplink_epoch=None) -> Computed:
     """Two/three-way range (RU, m or s) of rows with reception epochs ``t3_utc`` (datetime64[ns]).
 
     ``uplink``: ramp store or :class:`ConstantUplink`; ``ru_factor``: F per row;
-    ``modulus``: M in RU per row (NaN: no wrap). Parameters: 'bias' (unit) and
+    ``modulus``: M in RU per row (NaN: no wrap); ``uplink_epoch``: UTC datetime64[ns] per row at which
+    the range reads the uplink phase (RU only; NaT or None: reception). Parameters: 'bias' (unit) and
     'delay' (d value/d delay_s).
     """
     delay = np.broadcast_to(np.asarray(delay_s, dtype=float), sol.epochs[:, 0].shape)
@@ -65,7 +70,9 @@ def dsn_range(sol, uplink, station_tx, t3_utc, ru_factor, unit: str = "RU", dela
     if unit == "RU":
         f1 = uplink.frequency(station_tx, t3_utc, -rho)
         gain = np.asarray(ru_factor, dtype=float) * f1
-        value = np.asarray(ru_factor, dtype=float) * uplink.phase(station_tx, t3_utc, t3_utc, -rho, 0.0)
+        t3 = np.asarray(t3_utc, dtype="datetime64[ns]")
+        read = t3 if uplink_epoch is None else np.where(np.isnat(uplink_epoch), t3, uplink_epoch)
+        value = np.asarray(ru_factor, dtype=float) * uplink.phase(station_tx, t3, read, -rho, 0.0)
         m = np.broadcast_to(np.asarray(modulus, dtype=float), value.shape)
         value = np.where(np.isfinite(m), np.mod(value, np.where(np.isfinite(m), m, 1.0)), value)
     elif unit in ("m", "s"):

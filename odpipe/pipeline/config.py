@@ -173,6 +173,21 @@ class EditWindowSection:
 
 
 @dataclass
+class UplinkEpochSection:
+    """Range rows tagged in [start, end] (UTC) read the uplink phase ``into_ramp_s`` s into the ramp record
+    holding their tag (``uplink_epoch`` of :func:`odpipe.measurements.dsn.dsn_range`); rows tagged earlier in
+    their record are removed (flag USER). MESSENGER's odf07155: docs/validation.md."""
+
+    start: str = checked(utc_time)  # UTC ISO time, first tag
+    end: str = checked(utc_time)  # UTC ISO time, last tag
+    reason: str  # what shows the rows read the uplink phase there, kept in the configuration
+    station_rx: str = ""  # e.g. "DSS-14"; empty: every station
+    into_ramp_s: float = checked(positive, default=599.0)  # s after the start of the ramp record
+
+    problems = EditWindowSection.problems
+
+
+@dataclass
 class PreprocessSection:
     count_time: float = checked(positive, default=60.0)  # s, Doppler compression target
     # compressed windows cut short (gaps, ramp segments): keep them, flag them, or drop them
@@ -183,6 +198,7 @@ class PreprocessSection:
     apriori_blunder_k: float | None = checked(positive, default=None)
     min_pass_samples: int = checked(at_least(1), default=10)  # passes with fewer rows are flagged SHORT_PASS
     edit_windows: list[EditWindowSection] = field(default_factory=list)  # analyst edits (flag USER), each with its reason
+    range_uplink_epoch: list[UplinkEpochSection] = field(default_factory=list)  # range read at an earlier uplink phase
 
 
 @dataclass

@@ -38,6 +38,7 @@ from odpipe.preprocess.edit import EditConfig, edit
 from odpipe.preprocess.flags import Flag
 from odpipe.preprocess.flags import summary as flag_summary
 from odpipe.products import parameters, residuals
+from odpipe.tracking.ramps_phase_epoch import stale_uplink_range
 from parsers.atomic import write_parquet, write_text
 from odpipe.products.oem import write_oem
 from odpipe.products.spk import write_spk
@@ -141,6 +142,11 @@ def _run(cfg: RunConfig, attempt, log: RunLog, fingerprint: dict) -> dict:
                           min_pass_samples=pre.min_pass_samples, windows=[vars(w) for w in pre.edit_windows],
                           arc=(np.datetime64(cfg.arc.start, "ns"), np.datetime64(cfg.arc.end, "ns")))
     table, edits = edit(table, data.ramps, edit_cfg)
+    if pre.range_uplink_epoch:
+        table, removed = stale_uplink_range(table, data.ramps, pre.range_uplink_epoch)
+        edits = flag_summary(table["flags"])
+        log(f"range read at a stale uplink phase: {int(removed[1])} rows, {int(removed[0])} earlier in their ramp "
+            "record removed")
     log("edit: " + ", ".join(f"{r} {n}" for r, n in zip(edits["reason"], edits["rows"]) if n))
     before = table.iloc[:0]   # rows edited before the fit by a test on the rows it is given (per-station counts)
     if pre.apriori_blunder_k is not None:
