@@ -30,7 +30,9 @@ ONEWAY = {"data.observables": '["doppler_2way", "doppler_1way:X"]',
           "estimation.oscillator_sigma": "[1e-6, 1e-12]"}
 LOCK = {"preprocess.lock_transient_k": "10.0"}
 # name -> {"section.key": TOML literal}; "base" is the nightly configs as they are (since issue #24's rule:
-# stochastic sigma 3e-7 m/s^2 and preprocess.apriori_blunder_k 10; docs/validation.md names the earlier runs)
+# stochastic sigma 3e-7 m/s^2 and preprocess.apriori_blunder_k 10; docs/validation.md names the earlier runs).
+# The figures of docs/validation.md's lock-transient section were run at commit aaf3957, whose nightly was two-way
+# only; since then the nightly is what "oneway_lock" was, so "base" is that one now.
 CANDIDATES = {
     "base": {},
     "q1e-7": {"estimation.stochastic.sigma": "1e-7"},
