@@ -6,7 +6,7 @@ the receiver locks to again. Until its carrier loop has settled, the counted fre
 than the noise, for a few seconds. The 60-s windows of compression average the transient into the
 series' first point, where the spike tests, which judge a row by its neighbours on both sides, see only
 one side. GRAIL-B 2012-04-09, DSS-65's X-band one-way from 04:34:42 UTC: the first three 1-s samples are
-+8.0, +19.6 and +5.1 Hz off the next ten minutes' smooth course, where those samples scatter by 0.08 Hz;
++8.0, +19.6 and +5.1 Hz off the next ten minutes' smooth course, where those samples scatter by 0.03-0.08 Hz;
 averaged into the first 60-s point they make it +18.9 mm/s.
 
 The test judges each contiguous raw series (one link, equally spaced samples at their own count time)
