@@ -32,7 +32,7 @@ LOCK = {"preprocess.lock_transient_k": "10.0"}
 # name -> {"section.key": TOML literal}; "base" is the nightly configs as they are (since issue #24's rule:
 # stochastic sigma 3e-7 m/s^2 and preprocess.apriori_blunder_k 10; docs/validation.md names the earlier runs).
 # The figures of docs/validation.md's lock-transient section were run at commit aaf3957, whose nightly was two-way
-# only; since then the nightly is what "oneway_lock" was, so "base" is that one now.
+# only; since then the nightly is what "oneway_lock" was, so "base" is that one now (and "2day" is "2day_oneway_lock").
 CANDIDATES = {
     "base": {},
     "q1e-7": {"estimation.stochastic.sigma": "1e-7"},
