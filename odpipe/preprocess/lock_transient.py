@@ -7,7 +7,7 @@ than the noise, for a few seconds. The 60-s windows of compression average the t
 series' first point, where the spike tests, which judge a row by its neighbours on both sides, see only
 one side. GRAIL-B 2012-04-09, DSS-65's X-band one-way from 04:34:42 UTC: the first three 1-s samples are
 +8.0, +19.6 and +5.1 Hz off the next ten minutes' smooth course, where those samples scatter by 0.03-0.08 Hz;
-averaged into the first 60-s point they make it +18.9 mm/s.
+averaged into the first 60-s point they make it +20.0 mm/s (the one-way fit's residual there: +18.9).
 
 The test judges each contiguous raw series (one link, equally spaced samples at their own count time)
 against itself, before compression: fourth differences cancel a signal smooth to degree 3 over five
@@ -24,9 +24,9 @@ import pandas as pd
 
 from odpipe.tracking.passes import LINK
 
+from .compress import RATE_UNITS   # count-averaged Doppler (running counts in cycles are not judged)
 from .robust import MAD_TO_SIGMA
 
-RATE_UNITS = ("Hz", "m/s")   # count-averaged Doppler (running counts in cycles are not judged)
 MAX_LOCK_S = 60.0   # s: one compressed window; carrier loops settle within seconds
 CLEAN_RUN = 3       # consecutive fourth differences within bounds: the loop has settled
 SPACING_TOL = 1e-3  # s: samples this close to one count time apart are back to back
