@@ -9,13 +9,15 @@ Inputs are the figures of every candidate setting on every arc of a chain:
 A figure may use more arcs' data than its own (a two-day arc, an overlap of one with a daily arc): an
 optional ``days`` column (arc names joined by ","; default the row's ``arc``, or ``a`` and ``b``) names
 them all, and an optional ``judges`` column of ``overlaps`` the arcs whose solution it judges (default
-``a`` and ``b``) and an optional ``vs`` column the arc it was compared with (default the other of ``a``, ``b``).
+``a`` and ``b``), and an optional ``vs`` column the arc it was compared with (default the other of ``a``
+and ``b``).
 
 The rule, for a set of training arcs (any arcs but the judged one), takes the candidates with a figure for
 every training arc and sees only figures whose ``days`` are all training arcs: a candidate is admissible
-when every such arc figure converged with every station at most ``max_rms`` mm/s; among the admissible ones (all candidates when none is) it takes the smallest mean 3D
-overlap RMS over such overlaps (none: not chosen), then the smallest mean worst-station RMS. An unseen
-arc is judged with the candidate the rule picks on all the arcs before it.
+when every such arc figure converged with every station at most ``max_rms`` mm/s; among the admissible
+ones (all candidates when none is) it takes the smallest mean 3D overlap RMS over such overlaps (none: not
+chosen), then the smallest mean worst-station RMS. An unseen arc is judged with the candidate the rule
+picks on all the arcs before it.
 """
 
 from __future__ import annotations
@@ -32,10 +34,12 @@ def _days(table: pd.DataFrame, column: str, default) -> pd.Series:
 
 
 def arc_days(arcs: pd.DataFrame) -> pd.Series:
+    """The arcs whose data each arc figure uses."""
     return _days(arcs, "days", lambda r: {r.arc})
 
 
 def overlap_days(overlaps: pd.DataFrame, column: str = "days") -> pd.Series:
+    """The arcs whose data each overlap uses (``column`` "days"), or whose solutions it judges ("judges")."""
     return _days(overlaps, column, lambda r: {r.a, r.b})
 
 
