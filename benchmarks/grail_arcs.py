@@ -125,8 +125,9 @@ def trajectory(out: Path, name: str):
     return oem_trajectory(out / name / "current" / "trajectory.oem")
 
 
-def overlap_figures(out: Path, a: str, b: str, step: float = 60.0) -> dict:
-    """3D and R/I/C position RMS (m) of the overlap of arcs ``a`` and ``b`` (a − b, a's axes)."""
-    s = compare(trajectory(out, a), trajectory(out, b), f"{a} - {b}", step).statistics()
+def overlap_figures(out: Path, a: str, b: str, step: float = 60.0, out_b: Path | None = None) -> dict:
+    """3D and R/I/C position RMS (m) of the overlap of arcs ``a`` (in ``out``) and ``b`` (in ``out_b``, default
+    ``out``): a − b, a's axes."""
+    s = compare(trajectory(out, a), trajectory(out_b or out, b), f"{a} - {b}", step).statistics()
     return {"a": a, "b": b, "pos_3d_rms": s["pos_3d_rms"], "radial": s["pos_radial_rms"],
             "intrack": s["pos_intrack_rms"], "crosstrack": s["pos_crosstrack_rms"], "hours": s["hours"]}

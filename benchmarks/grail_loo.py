@@ -25,8 +25,14 @@ import pandas as pd
 from grail_arcs import DAILY, ORDER, PAIRS, SOURCE, START, arc_figures, overlap_figures, run_start, run_variant
 from odpipe.analysis.leave_one_out import held_out
 
+ONEWAY = {"data.observables": '["doppler_2way", "doppler_1way:X"]',
+          "estimation.data_sigma": "{ doppler_2way = 0.002, doppler_1way = 0.002 }",
+          "estimation.oscillator_sigma": "[1e-6, 1e-12]"}
+LOCK = {"preprocess.lock_transient_k": "10.0"}
 # name -> {"section.key": TOML literal}; "base" is the nightly configs as they are (since issue #24's rule:
-# stochastic sigma 3e-7 m/s^2 and preprocess.apriori_blunder_k 10; docs/validation.md names the earlier runs)
+# stochastic sigma 3e-7 m/s^2 and preprocess.apriori_blunder_k 10; docs/validation.md names the earlier runs).
+# The figures of docs/validation.md's lock-transient section were run at commit aaf3957, whose nightly was two-way
+# only; since then the nightly is what "oneway_lock" was, so "base" is that one now (and "2day" is "2day_oneway_lock").
 CANDIDATES = {
     "base": {},
     "q1e-7": {"estimation.stochastic.sigma": "1e-7"},
@@ -39,10 +45,57 @@ CANDIDATES = {
     "bias": {"estimation.doppler_bias_sigma": "0.002"},
     "timing": {"estimation.station_time_offset_sigma": "0.01"},
     # the X-band one-way Doppler too (runs/grail_b_oneway_2012_04_10.toml's settings), the oscillator estimated
-    "oneway": {"data.observables": '["doppler_2way", "doppler_1way:X"]',
-               "estimation.data_sigma": "{ doppler_2way = 0.002, doppler_1way = 0.002 }",
-               "estimation.oscillator_sigma": "[1e-6, 1e-12]"},
+    "oneway": ONEWAY,
+    # raw Doppler samples in a receiver lock transient edited (odpipe/preprocess/lock_transient.py), alone and
+    # with the one-way X band
+    "lock": LOCK,
+    "oneway_lock": {**ONEWAY, **LOCK},
 }
+
+# Two-day arcs (runs/grail_b_2day_*.toml) as candidates: name -> the daily candidate whose settings they take and
+# whose daily arcs they are compared with.
+TWO_DAY_CANDIDATES = {"2day": "base", "2day_oneway_lock": "oneway_lock"}
+D08, D09, D10, D11 = DAILY
+# two-day arc -> (the arc whose solution gives its a priori, the days it fits, the days whose product it is (the
+# nightly fitting the last two days: 04-08's is the first two), the independent daily arcs it overlaps: one
+# before or after it, sharing 3-4 h of data as consecutive daily arcs do)
+TWO_DAYS = {"grail_b_2day_2012_04_08": (D09, (D08, D09), (D08, D09), (D10,)),
+            "grail_b_2day_2012_04_09": (START, (D09, D10), (D10,), (D08, D11)),
+            "grail_b_2day_2012_04_10": (D10, (D10, D11), (D11,), (D09,))}
+
+
+def run_two_day(out: Path, cand: str, log) -> None:
+    """The two-day arcs of candidate ``cand``, each from its source arc's run by the paired daily candidate."""
+    daily = TWO_DAY_CANDIDATES[cand]
+    for name, (source, *_rest) in TWO_DAYS.items():
+        if source != START and not (out / cand / source).exists():
+            (out / cand).mkdir(parents=True, exist_ok=True)
+            (out / cand / source).symlink_to(out / daily / source)
+        run_variant(out / cand, CANDIDATES[daily], out / "start", arcs=(name,), source={name: source}, log=log)
+
+
+def collect_two_day(out: Path, cand: str) -> tuple[list, list]:
+    """Figures of ``cand``'s finished two-day arcs, in the form of :func:`collect`'s with the ``days`` each uses
+    (and for overlaps the products they judge and the daily arc compared with, ``vs``)."""
+    arcs, overlaps = [], []
+    daily = out / TWO_DAY_CANDIDATES[cand]
+    for name, (_, days, products, neighbours) in TWO_DAYS.items():
+        if not (out / cand / name / "current" / "summary.json").exists():
+            continue
+        row = arc_figures(out / cand, name)
+        summary = pd.read_json(out / cand / name / "current" / "summary.json", typ="series")
+        rms = [v for k, v in row.items() if k.startswith(("rms_mm_s.", "rms1w_mm_s."))]
+        for arc in products:
+            arcs.append({**row, "candidate": cand, "arc": arc, "solution": name, "days": ",".join(days),
+                         "converged": bool(summary["converged"]), "worst_rms": max(rms)})
+        for n in neighbours:
+            if not (daily / n / "current" / "trajectory.oem").exists():
+                continue
+            window = (days[-1], n) if n > days[-1] else (n, days[0])
+            fig = overlap_figures(out / cand, name, n, out_b=daily)
+            overlaps.append({**fig, "candidate": cand, "a": window[0], "b": window[1], "vs": n,
+                             "days": ",".join(sorted({*days, n})), "judges": ",".join(products), "solution": name})
+    return arcs, overlaps
 
 
 def collect(out: Path, names) -> tuple[pd.DataFrame, pd.DataFrame]:
@@ -59,6 +112,10 @@ def collect(out: Path, names) -> tuple[pd.DataFrame, pd.DataFrame]:
         for a, b in PAIRS:
             if a in done and b in done:
                 overlaps.append({"candidate": cand, **overlap_figures(out / cand, a, b)})
+    for cand in TWO_DAY_CANDIDATES:
+        more_arcs, more_overlaps = collect_two_day(out, cand)
+        arcs += more_arcs
+        overlaps += more_overlaps
     return pd.DataFrame(arcs), pd.DataFrame(overlaps)
 
 
@@ -70,25 +127,28 @@ def main(argv=None):
     ap.add_argument("--source-from", default="", help="candidate whose source-arc runs give the a priori")
     args = ap.parse_args(argv)
     out = args.out.resolve()
-    names = [n for n in CANDIDATES if not args.only or n in args.only.split(",")]
+    names = [n for n in [*CANDIDATES, *TWO_DAY_CANDIDATES] if not args.only or n in args.only.split(",")]
     t0 = time.perf_counter()
     run_start(out / "start")
     print(f"start-up fit ready ({time.perf_counter() - t0:.0f} s)", flush=True)
     chosen = [a for a in ORDER if not args.arcs or a in args.arcs.split(",")]
+    log = lambda s: print(f"[{time.perf_counter() - t0:6.0f} s] {s}", flush=True)  # noqa: E731
     for cand in names:
+        if cand in TWO_DAY_CANDIDATES:
+            run_two_day(out, cand, log)
+            continue
         if args.source_from and cand != args.source_from:
             for a in {SOURCE[a] for a in chosen} - {START} - set(chosen):
                 link = out / cand / a
                 if not link.exists():
                     link.parent.mkdir(parents=True, exist_ok=True)
                     link.symlink_to(out / args.source_from / a)
-        run_variant(out / cand, CANDIDATES[cand], out / "start", arcs=chosen,
-                    log=lambda s: print(f"[{time.perf_counter() - t0:6.0f} s] {s}", flush=True))
+        run_variant(out / cand, CANDIDATES[cand], out / "start", arcs=chosen, log=log)
         arcs, overlaps = collect(out, CANDIDATES)
         arcs.to_csv(out / "arcs.csv", index=False)
         overlaps.to_csv(out / "overlaps.csv", index=False)
     arcs, overlaps = collect(out, CANDIDATES)
-    complete = arcs.groupby("candidate")["arc"].nunique()
+    complete = arcs.groupby("candidate")["arc"].nunique()   # a candidate with a failed arc is left out
     full = complete[complete == len(DAILY)].index
     table = held_out(arcs[arcs["candidate"].isin(full)], overlaps[overlaps["candidate"].isin(full)])
     table.to_csv(out / "held_out.csv", index=False)

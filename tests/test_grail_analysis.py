@@ -43,6 +43,26 @@ def test_rule_prefers_admissible_candidates():
     assert choose(arcs, ov, ["a1", "a2", "a3"], max_rms=3.0) == "x"
 
 
+def test_figures_that_use_the_judged_arcs_data_are_not_seen():
+    # "z" fits two arcs at once: its figures use the data of every arc they name in ``days``; its overlaps
+    # are with "y"'s daily arcs outside them and judge the products named in ``judges``
+    rms = {(c, a): 1.0 for c in "y" for a in ARCS}
+    arcs, ov = _figures(rms, {("y", k): 400.0 for k in range(3)})
+    z = pd.DataFrame([{"candidate": "z", "arc": a, "converged": True, "worst_rms": 1.0, "days": d}
+                      for a, d in (("a1", "a1,a2"), ("a2", "a1,a2"), ("a3", "a2,a3"), ("a4", "a3,a4"))])
+    zo = pd.DataFrame([{"candidate": "z", "a": "a2", "b": "a3", "vs": "a3", "pos_3d_rms": 100.0, "radial": 1.0,
+                        "intrack": 100.0, "crosstrack": 0.0, "days": "a1,a2,a3", "judges": "a1,a2"},
+                       {"candidate": "z", "a": "a2", "b": "a3", "vs": "a2", "pos_3d_rms": 150.0, "radial": 1.0,
+                        "intrack": 150.0, "crosstrack": 0.0, "days": "a2,a3,a4", "judges": "a4"}])
+    arcs, ov = pd.concat([arcs, z], ignore_index=True), pd.concat([ov, zo], ignore_index=True)
+    assert choose(arcs, ov, ["a1", "a2", "a3"]) == "z"   # its first overlap: 100 m against 400 m
+    assert choose(arcs, ov, ["a1", "a3", "a4"]) == "y"   # no "z" overlap without a2's data
+    table = held_out(arcs, ov).set_index("arc")
+    assert table.loc["a4", "candidate"] == "z" and table.loc["a4", "overlap_a2_pos_3d_rms"] == 150.0
+    assert table.loc["a3", "candidate"] == "y" and table.loc["a2", "candidate"] == "y"
+    assert table.loc["a1", "candidate"] == "z" and table.loc["a1", "overlap_a3_pos_3d_rms"] == 100.0
+
+
 def test_klobuchar_night_floor_and_day_peak():
     """IS-GPS-200: 5 ns at night times the obliquity F = 1 + 16 (0.53 - E)^3; at 14:00 local time at the
     pierce point, 5 ns + AMP. Zenith (E = 0.5 semicircle), azimuth 0, longitude 0: the pierce point's

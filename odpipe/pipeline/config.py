@@ -196,6 +196,9 @@ class PreprocessSection:
     blunder_k: float = checked(positive, default=10.0)  # robust sigmas of a pass's detrended values: BLUNDER
     # robust sigmas of a pass's a priori residuals, detrended the same way: BLUNDER (none: not tested)
     apriori_blunder_k: float | None = checked(positive, default=None)
+    # robust sigmas of a raw Doppler series' fourth differences: its first samples before they settle within
+    # them (a receiver lock transient, within 60 s of the series' start) are BLUNDER (none: not tested)
+    lock_transient_k: float | None = checked(positive, default=None)
     min_pass_samples: int = checked(at_least(1), default=10)  # passes with fewer rows are flagged SHORT_PASS
     edit_windows: list[EditWindowSection] = field(default_factory=list)  # analyst edits (flag USER), each with its reason
     range_uplink_epoch: list[UplinkEpochSection] = field(default_factory=list)  # range read at an earlier uplink phase

@@ -33,6 +33,7 @@ from odpipe.pipeline.geometry import add_geometry, apparent_itrs, median_round_t
 from odpipe.pipeline.ingest import ingest
 from odpipe.pipeline.fitted_trajectory import fitted_segments
 from odpipe.preprocess.apriori_blunders import apriori_blunders
+from odpipe.preprocess.lock_transient import lock_transients
 from odpipe.preprocess.compress import compress
 from odpipe.preprocess.edit import EditConfig, edit
 from odpipe.preprocess.flags import Flag
@@ -132,6 +133,11 @@ def _run(cfg: RunConfig, attempt, log: RunLog, fingerprint: dict) -> dict:
         log("calibrate: media corrections off (calibration.media = false)")
 
     pre = cfg.preprocess
+    if pre.lock_transient_k is not None:   # on the raw samples: compression would average them into a pass's first row
+        lock = lock_transients(table, pre.lock_transient_k)
+        table.loc[lock, "flags"] = table.loc[lock, "flags"] | int(Flag.BLUNDER)
+        log(f"edit: raw Doppler samples in a lock transient {int(lock.sum())}"
+            + "".join(f", {k} {v}" for k, v in table.loc[lock, "station_rx"].value_counts().sort_index().items()))
     rtlt = median_round_trip(table)
     n_raw = len(table)
     table, creport = compress(table, pre.count_time, ramps=data.ramps, partial=pre.partial, ramp_delay=rtlt)
