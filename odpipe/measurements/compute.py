@@ -135,11 +135,11 @@ def compute(rows: pd.DataFrame, trajectories: Mapping, setup: MeasurementSetup) 
     n = len(rows)
     out = Evaluation(np.full(n, np.nan), np.full(n, np.nan), np.full(n, "", dtype=object), {}, {})
     df = rows.reset_index(drop=True)
-    setup = _spanning(setup, df["epoch"])
+    setup = _remembering(_spanning(setup, df["epoch"]))
     sc2 = df["spacecraft_2"] if "spacecraft_2" in df.columns else pd.Series([""] * n)
     keys = [df["observable"], df["unit"], df["station_tx"], df["station_rx"], df["spacecraft"].astype(str),
             sc2.astype(str), df["tag"]]
-    for key, idx in pd.DataFrame(dict(enumerate(keys))).groupby(list(range(7)), sort=False).indices.items():
+    for key, idx in _groups(keys):
         g = df.iloc[idx]
         try:
             comp, roles = _evaluate(key, g, trajectories, setup)
@@ -148,6 +148,66 @@ def compute(rows: pd.DataFrame, trajectories: Mapping, setup: MeasurementSetup) 
             continue
         _store(out, idx, n, comp, roles, g, setup)
     return out
+
+
+def _groups(keys: list) -> list[tuple[tuple, np.ndarray]]:
+    """(key values, row positions) of each distinct combination of the ``keys`` columns, in order of first
+    appearance; rows with a missing key are left out (as pandas' ``groupby`` does, at a fraction of its cost)."""
+    code = np.zeros(len(keys[0]), np.int64)
+    missing = np.zeros(code.size, bool)
+    for col in keys:
+        c, u = pd.factorize(col)
+        missing |= c < 0
+        code = code * (len(u) + 1) + (c + 1)
+    code[missing] = -1
+    uniq, first, inverse = np.unique(code, return_index=True, return_inverse=True)
+    return [(tuple(col.iloc[first[j]] for col in keys), np.flatnonzero(inverse == j))
+            for j in np.argsort(first) if uniq[j] >= 0]
+
+
+class _RememberedEphemeris:
+    """An ephemeris whose states are remembered by (target, centre, epochs) for one :func:`compute` call: its
+    light-time solutions ask for the Earth at the same epochs for stations, the spacecraft, the Shapiro delay
+    and station clocks. Remembered arrays are read-only."""
+
+    def __init__(self, ephemeris):
+        self._ephemeris, self._states = ephemeris, {}
+
+    def state(self, target, center, t):
+        t = np.asarray(t, dtype=float)
+        key = (target, center, t.shape, t.tobytes())
+        out = self._states.get(key)
+        if out is None:
+            out = np.asarray(self._ephemeris.state(target, center, t), dtype=float)
+            out.setflags(write=False)
+            self._states[key] = out
+        return out
+
+    def __getattr__(self, name):
+        return getattr(self._ephemeris, name)
+
+
+class _RememberedRotation:
+    """The GCRS-to-ITRS matrices remembered by epochs for one :func:`compute` call (read-only)."""
+
+    def __init__(self, rotation):
+        self._rotation, self._matrices = rotation, {}
+
+    def __call__(self, t):
+        t = np.asarray(t, dtype=float)
+        key = (t.shape, t.tobytes())
+        out = self._matrices.get(key)
+        if out is None:
+            out = np.asarray(self._rotation(t), dtype=float)
+            out.setflags(write=False)
+            self._matrices[key] = out
+        return out
+
+
+def _remembering(setup: MeasurementSetup) -> MeasurementSetup:
+    eph = None if setup.ephemeris is None else _RememberedEphemeris(setup.ephemeris)
+    rot = None if setup.gcrs_to_itrs is None else _RememberedRotation(setup.gcrs_to_itrs)
+    return replace(setup, ephemeris=eph, gcrs_to_itrs=rot)
 
 
 SPAN_MARGIN_S = SECONDS_PER_DAY  # s around the rows' epochs: light times (hours) and count intervals
