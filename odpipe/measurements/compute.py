@@ -130,17 +130,41 @@ class _Unsupported(Exception):
     pass
 
 
-def compute(rows: pd.DataFrame, trajectories: Mapping, setup: MeasurementSetup) -> Evaluation:
-    """Computed observables and partials of ``rows`` (a TrackingTable slice) given trajectories by spacecraft id."""
-    n = len(rows)
-    out = Evaluation(np.full(n, np.nan), np.full(n, np.nan), np.full(n, "", dtype=object), {}, {})
+@dataclass
+class Prepared:
+    """Rows grouped once for :func:`compute`, for callers that evaluate the same rows again with other
+    trajectories (a fit's segment at every iteration): the rows (index reset), their groups (key values,
+    positions, rows) and the TDB span (s) of their epochs (None without rows)."""
+
+    rows: pd.DataFrame
+    groups: list
+    span: tuple | None
+
+
+def prepare(rows: pd.DataFrame) -> Prepared:
+    """The :class:`Prepared` grouping of ``rows`` (a TrackingTable slice)."""
     df = rows.reset_index(drop=True)
-    setup = _remembering(_spanning(setup, df["epoch"]))
+    n = len(df)
+    if not n:
+        return Prepared(df, [], None)
     sc2 = df["spacecraft_2"] if "spacecraft_2" in df.columns else pd.Series([""] * n)
     keys = [df["observable"], df["unit"], df["station_tx"], df["station_rx"], df["spacecraft"].astype(str),
             sc2.astype(str), df["tag"]]
-    for key, idx in _groups(keys):
-        g = df.iloc[idx]
+    t, _ = anchor_from_utc(np.array([df["epoch"].min(), df["epoch"].max()], dtype="datetime64[ns]"))
+    return Prepared(df, [(key, idx, df.iloc[idx]) for key, idx in _groups(keys)], (float(t[0]), float(t[1])))
+
+
+def compute(rows: pd.DataFrame, trajectories: Mapping, setup: MeasurementSetup,
+            prepared: Prepared | None = None) -> Evaluation:
+    """Computed observables and partials of ``rows`` (a TrackingTable slice) given trajectories by spacecraft id;
+    ``prepared``: :func:`prepare` of these rows, when the caller keeps it."""
+    prep = prepare(rows) if prepared is None else prepared
+    n = len(prep.rows)
+    out = Evaluation(np.full(n, np.nan), np.full(n, np.nan), np.full(n, "", dtype=object), {}, {})
+    if prep.span is not None:
+        setup = spanning(setup, prep.span[0] - SPAN_MARGIN_S, prep.span[1] + SPAN_MARGIN_S)
+    setup = _remembering(setup)
+    for key, idx, g in prep.groups:
         try:
             comp, roles = _evaluate(key, g, trajectories, setup)
         except _Unsupported as exc:
@@ -222,14 +246,6 @@ def spanning(setup: MeasurementSetup, t0: float, t1: float) -> MeasurementSetup:
     if rot is not None and not isinstance(rot, TabulatedRotation):
         rot = TabulatedRotation(rot, t0, t1)
     return replace(setup, ephemeris=eph, gcrs_to_itrs=rot)
-
-
-def _spanning(setup: MeasurementSetup, epoch: pd.Series) -> MeasurementSetup:
-    """``setup`` tabulated over the rows' epochs with :data:`SPAN_MARGIN_S` either side."""
-    if not len(epoch):
-        return setup
-    t, _ = anchor_from_utc(np.array([epoch.min(), epoch.max()], dtype="datetime64[ns]"))
-    return spanning(setup, t[0] - SPAN_MARGIN_S, t[1] + SPAN_MARGIN_S)
 
 
 @dataclass

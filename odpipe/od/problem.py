@@ -55,6 +55,7 @@ import pandas as pd
 
 from odpipe.dynamics.forces import EmpiricalRTN, ForceModel
 from odpipe.measurements import MeasurementSetup, compute, residuals
+from odpipe.measurements.compute import prepare
 from odpipe.measurements.timetag import tag_rate
 
 from .segment import SegmentTrajectory, ShiftedSegmentTrajectory
@@ -126,6 +127,7 @@ class TrackingProblem:
         self.shared = {} if shared is None else shared
         self.coarse, self._coarse = coarse, False
         self._segments: list[_Segment] = []
+        self._prepared: dict = {}   # (lo, hi) -> measurements.compute.Prepared of those rows
         self._last = (None, None)   # (segment, x1) of the last transition, to skip re-checks
         params = registry.parameters
         bad = sorted({p.kind for p in params} - set(_SUPPORTED))
@@ -300,13 +302,16 @@ class TrackingProblem:
 
     def _evaluate(self, lo, hi, trajs, x0):
         n, m = len(self.registry), hi - lo
-        rows = self.rows.iloc[lo:hi]
         G_x, G_p = {}, {}
         H_lin = np.zeros((m, n))
         if m == 0:
             return np.zeros(0), np.zeros(0), np.zeros(0, object), G_x, G_p, H_lin
+        if (lo, hi) not in self._prepared:   # a segment's rows are grouped once, not at every iteration
+            self._prepared[(lo, hi)] = prepare(self.rows.iloc[lo:hi])
+        prepared = self._prepared[(lo, hi)]
+        rows = prepared.rows
         setup = self._measurement_setup(x0)
-        ev = compute(rows, trajs, setup)
+        ev = compute(rows, trajs, setup, prepared)
         res, _ = residuals(rows, ev)
         observed = rows["value"].to_numpy(float)
         value = np.where(np.isfinite(observed), observed - res, ev.value)  # computed, wrapped to the observation
