@@ -65,14 +65,6 @@ def _augmented(R, z) -> np.ndarray:
     return A
 
 
-def information_estimate(R, z, n_est, c_bar, triangular=False) -> np.ndarray:
-    """Estimate only (no covariance) from an information array, consider part at ``c_bar``."""
-    n = R.shape[1]
-    T = _augmented(R, z) if triangular else triangularize(_augmented(R, z))
-    Rinv = _inverse(T[:n_est, :n_est])
-    return np.concatenate([Rinv @ (T[:n_est, n] - T[:n_est, n_est:n] @ c_bar), c_bar])
-
-
 def _inverse(R):
     """Inverse of an upper-triangular matrix (LAPACK trtri; small, unthreaded)."""
     Rinv, info = dtrtri(R)
@@ -112,7 +104,8 @@ def _stacked_factors(R, z, n_est):
 
 
 def information_estimates(R, z, n_est, c_bar) -> np.ndarray:
-    """:func:`information_estimate` of K stacked arrays R (K, m, n), z (K, m) at once: (K, n)."""
+    """Estimates only (no covariance) of K stacked information arrays R (K, m, n), z (K, m), the consider part
+    at ``c_bar``: (K, n)."""
     Rinv, Rec, ze = _stacked_factors(R, z, n_est)
     K = Rinv.shape[0]
     xe = np.einsum("kij,kj->ki", Rinv, ze - Rec @ c_bar)
