@@ -134,6 +134,7 @@ class Ephemeris:
         self.name = name
         self._links = links
         self._gm = gm_m3
+        self._interpolants: dict = {}   # (bodies, centre, first piece, pieces, piece_s, ncoef) -> interpolant
 
     @classmethod
     def open(cls, name_or_path: str | Path = "de440") -> "Ephemeris":
@@ -277,6 +278,13 @@ class Ephemeris:
         origin = self._links[self._chain(ids[0])[0] if ids[0] != 0 else self._chain(body_id(center))[0]].record_origin
         t0 = origin + np.floor((t0 - origin) / piece_s) * piece_s
         npiece = max(1, int(np.ceil((t1 - t0) / piece_s)))
+        key = (ids, body_id(center), float(t0), npiece, float(piece_s), int(ncoef))
+        if key not in self._interpolants:   # a fit's segments ask for the same aligned pieces again
+            self._interpolants[key] = self._fit_pieces(ids, center, t0, npiece, piece_s, ncoef)
+        return self._interpolants[key]
+
+    def _fit_pieces(self, ids, center, t0, npiece, piece_s, ncoef) -> "EphemerisInterpolant":
+        """The Chebyshev pieces of :meth:`interpolant` from ``t0`` (aligned), computed."""
         k = np.arange(ncoef)
         x = np.cos(np.pi * (k + 0.5) / ncoef)  # Chebyshev-Gauss nodes on [-1, 1]
         # node epochs as two-part Julian dates: whole days of the (integral) piece starts plus a

@@ -48,7 +48,7 @@ import pandas as pd
 from .registry import ParameterRegistry
 from .smoother import smooth_arrays
 from .solution import Solution, checksum
-from .srif import SRIF, information_estimate, solve_information
+from .srif import SRIF, information_estimates, solve_information, solve_informations
 
 _log = logging.getLogger(__name__)
 
@@ -205,25 +205,36 @@ def _filter_smoother_pass(problem, obs, grid, steps, bounds, x_ref0, p_after, si
         refs.append(xr)
         srif.mark(k)
         filt.append((srif.R, srif.z))
-        rows = np.arange(bounds[k], bounds[k + 1])
-        if rows.size:
+        lo, hi = bounds[k], bounds[k + 1]
+        if hi > lo:
+            rows = np.arange(lo, hi)
             computed, H = problem.predict(grid[k], xr, rows)
-            y = obs.value[rows] - computed
-            nonfinite = unusable[rows] | ~np.isfinite(y) | ~np.isfinite(H).all(axis=1)
-            flags[rows[nonfinite]] |= NONFINITE
-            use = ~nonfinite
-            nu, s = np.full(rows.size, np.nan), np.full(rows.size, np.nan)
-            nu[use], s[use] = srif.innovations(H[use], y[use], sig_row[rows][use])
-            # an outlier to the forward filter that the last smoothed solution (the reference) fits too is
-            # no blunder, only a surprise (an unmodelled acceleration after a burn): edited it locks the filter out
-            bad = use.copy()
-            bad[use] = np.abs(nu[use]) > edit_k * s[use]
-            if against_reference:
-                bad[use] &= np.abs(y[use]) > edit_k * sig_row[rows][use]
-            flags[rows[bad]] |= EDIT_INNOVATION
-            prefit[rows], innov[rows], innov_sig[rows] = y, nu, s
+            y = obs.value[lo:hi] - computed
+            sig = sig_row[lo:hi]
+            use = ~(unusable[lo:hi] | ~np.isfinite(y) | ~np.isfinite(H).all(axis=1))
+            if use.all():   # the usual block: every row computable
+                nu, s = srif.innovations(H, y, sig)
+                bad = np.abs(nu) > edit_k * s
+                if against_reference:
+                    bad &= np.abs(y) > edit_k * sig
+            else:
+                flags[lo:hi][~use] |= NONFINITE
+                nu, s = np.full(rows.size, np.nan), np.full(rows.size, np.nan)
+                nu[use], s[use] = srif.innovations(H[use], y[use], sig[use])
+                # an outlier to the forward filter that the last smoothed solution (the reference) fits too is
+                # no blunder, only a surprise (an unmodelled acceleration after a burn): edited it locks the
+                # filter out
+                bad = use.copy()
+                bad[use] = np.abs(nu[use]) > edit_k * s[use]
+                if against_reference:
+                    bad[use] &= np.abs(y[use]) > edit_k * sig[use]
+            flags[lo:hi][bad] |= EDIT_INNOVATION
+            prefit[lo:hi], innov[lo:hi], innov_sig[lo:hi] = y, nu, s
             keep = use & ~bad
-            srif.measurement_update(H[keep], y[keep], sig_row[rows][keep])
+            if keep.all():
+                srif.measurement_update(H, y, sig)
+            else:
+                srif.measurement_update(H[keep], y[keep], sig[keep])
             blocks.append((k, rows, H, y))
         xr, Phi = problem.transition(grid[k], grid[k + 1], xr)
         srif.time_update(Phi)
@@ -244,8 +255,19 @@ def _gaussian(ps: _Pass, R, z):
     return solve_information(R, z, f.n_est, f.c_bar, f.c_sigma)
 
 
-def _estimate(ps: _Pass, R, z):
-    return information_estimate(R, z, ps.srif.n_est, ps.srif.c_bar)
+def _estimates(ps: _Pass, arrays: dict) -> dict:
+    """Estimates (no covariance) from the information arrays ``{k: (R, z)}``, at once."""
+    keys = list(arrays)
+    x = information_estimates(np.array([arrays[k][0] for k in keys]), np.array([arrays[k][1] for k in keys]),
+                              ps.srif.n_est, ps.srif.c_bar)
+    return dict(zip(keys, x))
+
+
+def _gaussians(ps: _Pass, arrays: list) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """x (K, n), P (K, n, n), P_consider (K, n, n) of the information arrays ``[(R, z)]``, at once."""
+    f = ps.srif
+    return solve_informations(np.array([R for R, _ in arrays]), np.array([z for _, z in arrays]), f.n_est,
+                              f.c_bar, f.c_sigma)
 
 
 def fit(problem: Problem, obs: Observations, t_start: float, t_end: float,
@@ -299,7 +321,7 @@ def fit(problem: Problem, obs: Observations, t_start: float, t_end: float,
                     p_after[key] -= v
                 halvings += 1
         needed = {0} | {b[0] for b in ps.blocks} | set(steps)
-        dx = {k: _estimate(ps, *ps.smoothed[k]) for k in needed}
+        dx = _estimates(ps, {k: ps.smoothed[k] for k in sorted(needed)})
         ok = ps.flags == 0
         if not ok.any():
             raise NothingToFit(_nothing_left(ps.flags, it))
@@ -361,15 +383,15 @@ def fit(problem: Problem, obs: Observations, t_start: float, t_end: float,
                               "postfit": postfit, "innovation": ps.innovation,
                               "innovation_sigma": ps.innovation_sigma, "sigma": sig_row,
                               "flags": ps.flags})
-    filt = [_gaussian(ps, R, z) for R, z in ps.filtered]
-    sm = [_gaussian(ps, *ps.smoothed[k]) for k in range(grid.size)]
+    f_x, _, f_Pc = _gaussians(ps, ps.filtered)
+    s_x, s_P, s_Pc = _gaussians(ps, [ps.smoothed[k] for k in range(grid.size)])
     return Solution(
         names=reg.names, grid=grid,
-        filtered_x=refs + np.array([g.x for g in filt]),
-        filtered_P=_symmetric([g.P_consider for g in filt]),
-        smoothed_x=refs + np.array([g.x for g in sm]),
-        smoothed_P=_symmetric([g.P for g in sm]),
-        smoothed_P_consider=_symmetric([g.P_consider for g in sm]),
+        filtered_x=refs + f_x,
+        filtered_P=_symmetric(f_Pc),
+        smoothed_x=refs + s_x,
+        smoothed_P=_symmetric(s_P),
+        smoothed_P_consider=_symmetric(s_Pc),
         residuals=residuals, history=history, converged=converged,
         inputs={"observations": checksum(obs.time, obs.value, obs.sigma),
                 "apriori": checksum(reg.apriori, reg.sigma),

@@ -56,12 +56,13 @@ class Gaussian:
         return np.sqrt(np.diag(self.P_consider))
 
 
-def information_estimate(R, z, n_est, c_bar, triangular=False) -> np.ndarray:
-    """Estimate only (no covariance) from an information array, consider part at ``c_bar``."""
-    n = R.shape[1]
-    T = np.column_stack([R, z]) if triangular else triangularize(np.column_stack([R, z]))
-    Rinv = _inverse(T[:n_est, :n_est])
-    return np.concatenate([Rinv @ (T[:n_est, n] - T[:n_est, n_est:n] @ c_bar), c_bar])
+def _augmented(R, z) -> np.ndarray:
+    """``[R | z]``: (m, n + 1), or (K, m, n + 1) for stacks of arrays."""
+    R, z = np.asarray(R, float), np.asarray(z, float)
+    A = np.empty(R.shape[:-1] + (R.shape[-1] + 1,))
+    A[..., :-1] = R
+    A[..., -1] = z
+    return A
 
 
 def _inverse(R):
@@ -76,7 +77,7 @@ def solve_information(R, z, n_est, c_bar, c_sigma, triangular=False) -> Gaussian
     """Estimate and covariances from an information array (any row order unless
     ``triangular``, which skips the re-triangularization)."""
     n = R.shape[1]
-    T = np.column_stack([R, z]) if triangular else triangularize(np.column_stack([R, z]))
+    T = _augmented(R, z) if triangular else triangularize(_augmented(R, z))
     Ree, Rec, ze = T[:n_est, :n_est], T[:n_est, n_est:n], T[:n_est, n]
     Rinv = _inverse(Ree)
     S = Rinv @ Rec                          # -d(x_e)/d(c)
@@ -95,12 +96,48 @@ def solve_information(R, z, n_est, c_bar, c_sigma, triangular=False) -> Gaussian
     return Gaussian(x, P, Pc)
 
 
+def _stacked_factors(R, z, n_est):
+    """Triangular factors of stacked information arrays (K, m, n), (K, m): (T_ee^-1, T_ec, T_e,z)."""
+    n = R.shape[-1]
+    T = np.linalg.qr(_augmented(R, z), mode="r")
+    return np.linalg.inv(T[:, :n_est, :n_est]), T[:, :n_est, n_est:n], T[:, :n_est, n]
+
+
+def information_estimates(R, z, n_est, c_bar) -> np.ndarray:
+    """Estimates only (no covariance) of K stacked information arrays R (K, m, n), z (K, m), the consider part
+    at ``c_bar``: (K, n)."""
+    Rinv, Rec, ze = _stacked_factors(R, z, n_est)
+    K = Rinv.shape[0]
+    xe = np.einsum("kij,kj->ki", Rinv, ze - Rec @ c_bar)
+    return np.concatenate([xe, np.broadcast_to(c_bar, (K, c_bar.size))], axis=1)
+
+
+def solve_informations(R, z, n_est, c_bar, c_sigma) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """:func:`solve_information` of K stacked arrays at once: x (K, n), P (K, n, n), P_consider (K, n, n)."""
+    Rinv, Rec, ze = _stacked_factors(R, z, n_est)
+    K, n = Rinv.shape[0], R.shape[-1]
+    x = np.concatenate([np.einsum("kij,kj->ki", Rinv, ze - Rec @ c_bar),
+                        np.broadcast_to(c_bar, (K, c_bar.size))], axis=1)
+    P = np.zeros((K, n, n))
+    P[:, :n_est, :n_est] = Rinv @ Rinv.transpose(0, 2, 1)
+    if n_est == n:
+        return x, P, P
+    P[:, n_est:, n_est:] = np.diag(c_sigma**2)
+    Pc = P.copy()
+    S = Rinv @ Rec                          # -d(x_e)/d(c)
+    SP = S * c_sigma**2
+    Pc[:, :n_est, :n_est] += SP @ S.transpose(0, 2, 1)
+    Pc[:, :n_est, n_est:] = -SP
+    Pc[:, n_est:, :n_est] = -SP.transpose(0, 2, 1)
+    return x, P, Pc
+
+
 class SRIF:
     """Square-root information filter on an ``n``-vector, the last ``n - n_est`` considered."""
 
     def __init__(self, R, z, n_est=None, c_bar=None, c_sigma=None):
         n = np.shape(R)[1]
-        T = triangularize(np.column_stack([np.asarray(R, float), np.asarray(z, float)]))
+        T = triangularize(_augmented(R, z))
         self.R, self.z = T[:n, :n], T[:n, n]
         self.n_est = n if n_est is None else int(n_est)
         nc = n - self.n_est
@@ -130,8 +167,12 @@ class SRIF:
         the whitened residual sum of squares (also accumulated in ``chi2``)."""
         w = 1.0 / np.asarray(sigma, float)
         H = np.atleast_2d(H)
-        A = np.vstack([np.column_stack([self.R, self.z]),
-                       np.column_stack([H * w[:, None], np.asarray(y) * w])])
+        n = self.n
+        A = np.empty((n + H.shape[0], n + 1))
+        A[:n, :n] = self.R
+        A[:n, n] = self.z
+        A[n:, :n] = H * w[:, None]
+        A[n:, n] = np.asarray(y) * w
         T = triangularize(A)
         self._set(T)
         e2 = float(T[self.n, self.n] ** 2) if T.shape[0] > self.n else 0.0
@@ -143,8 +184,7 @@ class SRIF:
         lu, piv, RPhiInvT, info = dgesv(Phi.T, self.R.T)
         if info != 0:
             raise np.linalg.LinAlgError("singular transition matrix")
-        RPhiInv = RPhiInvT.T
-        self._set(triangularize(np.column_stack([RPhiInv, self.z])))
+        self._set(triangularize(_augmented(RPhiInvT.T, self.z)))
         self.log.append(("map", Phi))
 
     def process_noise(self, idx, m, q, offset=None):

@@ -55,6 +55,7 @@ import pandas as pd
 
 from odpipe.dynamics.forces import EmpiricalRTN, ForceModel
 from odpipe.measurements import MeasurementSetup, compute, residuals
+from odpipe.measurements.compute import prepare
 from odpipe.measurements.timetag import tag_rate
 
 from .segment import SegmentTrajectory, ShiftedSegmentTrajectory
@@ -126,6 +127,7 @@ class TrackingProblem:
         self.shared = {} if shared is None else shared
         self.coarse, self._coarse = coarse, False
         self._segments: list[_Segment] = []
+        self._prepared: dict = {}   # (lo, hi) -> measurements.compute.Prepared of those rows
         self._last = (None, None)   # (segment, x1) of the last transition, to skip re-checks
         params = registry.parameters
         bad = sorted({p.kind for p in params} - set(_SUPPORTED))
@@ -134,6 +136,7 @@ class TrackingProblem:
         self._key_idx = np.array([i for i, p in enumerate(params) if p.kind in _REFERENCE], int)
         self._lin_idx = np.array([i for i, p in enumerate(params) if p.kind in _LINEAR], int)
         self._sc = {sc: self._spacecraft_indices(sc) for sc in self.force_models}
+        self._state = {sc: slice(ix["state"][0], ix["state"][-1] + 1) for sc, ix in self._sc.items()}  # consecutive
         self._breaks = self._break_epochs()
 
     # -- registry layout ------------------------------------------------
@@ -299,13 +302,16 @@ class TrackingProblem:
 
     def _evaluate(self, lo, hi, trajs, x0):
         n, m = len(self.registry), hi - lo
-        rows = self.rows.iloc[lo:hi]
         G_x, G_p = {}, {}
         H_lin = np.zeros((m, n))
         if m == 0:
             return np.zeros(0), np.zeros(0), np.zeros(0, object), G_x, G_p, H_lin
+        if (lo, hi) not in self._prepared:   # a segment's rows are grouped once, not at every iteration
+            self._prepared[(lo, hi)] = prepare(self.rows.iloc[lo:hi])
+        prepared = self._prepared[(lo, hi)]
+        rows = prepared.rows
         setup = self._measurement_setup(x0)
-        ev = compute(rows, trajs, setup)
+        ev = compute(rows, trajs, setup, prepared)
         res, _ = residuals(rows, ev)
         observed = rows["value"].to_numpy(float)
         value = np.where(np.isfinite(observed), observed - res, ev.value)  # computed, wrapped to the observation
@@ -350,12 +356,14 @@ class TrackingProblem:
         loc = np.asarray(rows) - seg.lo
         if loc.size and (loc.min() < 0 or loc.max() >= seg.hi - seg.lo):
             raise ValueError(f"rows outside the segment [{seg.a}, {seg.b}) of t0={t0}")
-        H = seg.H_lin[loc]
+        if loc.size and loc[-1] - loc[0] == loc.size - 1:   # consecutive rows (the filter's blocks): a slice
+            loc = slice(int(loc[0]), int(loc[-1]) + 1)
+        H = seg.H_lin[loc].copy()
         computed = seg.value[loc] + H[:, self._lin_idx] @ x0[self._lin_idx]
         for sc, traj in seg.trajs.items():
             _, _, Phi0_inv, S0 = traj.at(t0)
             Hx = seg.G_x[sc][loc] @ Phi0_inv
-            H[:, self._sc[sc]["state"]] = Hx
+            H[:, self._state[sc]] = Hx
             H[:, seg.pidx[sc]] += seg.G_p[sc][loc] - Hx @ S0
         return computed, H
 
@@ -367,13 +375,13 @@ class TrackingProblem:
             raise ValueError(f"interval [{t0}, {t1}] crosses the segment end {seg.b}")
         x1, Phi = x0.copy(), np.eye(x0.size)
         for sc, traj in seg.trajs.items():
-            st = self._sc[sc]["state"]
+            st = self._state[sc]
             _, _, Phi0_inv, S0 = traj.at(t0)
             x_1, Phi1, _, S1 = traj.at(t1)
             M = Phi1 @ Phi0_inv
             x1[st] = x_1
-            Phi[np.ix_(st, st)] = M
-            Phi[np.ix_(st, seg.pidx[sc])] = S1 - M @ S0
+            Phi[st, st] = M
+            Phi[st, seg.pidx[sc]] = S1 - M @ S0
         self._last = (seg, x1)
         return x1, Phi
 
