@@ -1,6 +1,6 @@
 """Where a GRAIL-B daily arc spends its time: wall and CPU seconds by pipeline stage and by fit iteration.
 
-    python benchmarks/profile_grail_arc.py [runs/grail_b_2012_04_10.toml] [--interval 0.002]
+    python benchmarks/profile_grail_arc.py [runs/grail_b_2012_04_10.toml] [--interval 0.002] [--cprofile N]
 
 Runs the arc's configuration like ``odpipe run`` (``force``: always fitted again) while a
 sampling thread reads the main thread's Python stack every ``interval`` seconds. Each
@@ -26,12 +26,16 @@ on a loaded machine. Time inside ``odpipe.estimation.fit.fit`` is
 also split by (fit call, iteration, weight stage). numba compilation (none when its
 cache is warm: run twice) is reported apart. Integrations and force-model evaluations
 (``Trajectory.n_eval``, independent of the machine's load) are counted by where
-``propagate`` was called from. Figures are printed, never asserted.
+``propagate`` was called from. ``--cprofile N`` also runs cProfile on the CPU clock
+(``time.process_time``) and prints its N functions of most cumulative CPU time (the sampler's
+figures then include cProfile's own overhead). Figures are printed, never asserted.
 """
 
 from __future__ import annotations
 
 import argparse
+import cProfile
+import pstats
 import sys
 import threading
 import time
@@ -157,16 +161,24 @@ def main(argv=None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("config", nargs="?", type=Path, default=ROOT / "runs" / "grail_b_2012_04_10.toml")
     ap.add_argument("--interval", type=float, default=0.002, help="sampling interval, s")
+    ap.add_argument("--cprofile", type=int, default=0, metavar="N",
+                    help="also profile with cProfile on the CPU clock and print its top N functions")
     args = ap.parse_args(argv)
+    profiler = cProfile.Profile(time.process_time) if args.cprofile else None
     sampler = Sampler(threading.get_ident(), args.interval)
     sampler.start()
     t0, c0 = time.perf_counter(), time.process_time()
     try:
         with compile_timer() as ct, Integrations() as integ:
+            if profiler is not None:
+                profiler.enable()
             summary = run_config(args.config, force=True, progress=None)
     except ConfigError as exc:
         print(exc)
         return 1
+    finally:
+        if profiler is not None:
+            profiler.disable()
     wall, cpu = time.perf_counter() - t0, time.process_time() - c0
     sampler.stop.set()
     sampler.join()
@@ -190,6 +202,9 @@ def main(argv=None) -> int:
         print(f"{key:30s} {calls:6d} {evals:18d}")
     print(f"{'total':30s} {sum(c for c, _ in integ.count.values()):6d} "
           f"{sum(e for _, e in integ.count.values()):18d}")
+    if profiler is not None:
+        print("\ncProfile, CPU seconds")
+        pstats.Stats(profiler).sort_stats("cumulative").print_stats(args.cprofile)
     return 0
 
 

@@ -63,11 +63,13 @@ class RunLog:
 
 
 def fitted_rows(table: pd.DataFrame, observables: list[str]) -> np.ndarray:
-    """Rows of the configured observables: "observable", or "observable:BAND" for one downlink band."""
+    """Rows of the configured observables: "observable", or "observable:BAND" for one downlink band; a
+    running Doppler count (``doppler_count_<mode>``) is the ``doppler_<mode>`` row it is compressed into."""
     keep = np.zeros(len(table), bool)
+    names = table["observable"].astype(str).str.replace("doppler_count_", "doppler_", regex=False).to_numpy()
     for entry in observables:
         obs, _, band = entry.partition(":")
-        sel = table["observable"].to_numpy() == obs
+        sel = names == obs
         keep |= sel & (table["band_down"].astype(str).to_numpy() == band) if band else sel
     return keep
 
@@ -120,9 +122,10 @@ def _run(cfg: RunConfig, attempt, log: RunLog, fingerprint: dict) -> dict:
         model = MediaModel(read_trk223(*cal.tro, *cal.ion) if (cal.tro or cal.ion) else None,
                            IonexModel(read_ionex(*cal.ionex)) if cal.ionex else None, cal.standard_troposphere)
 
-        def media(rows, trajectory):
+        def media(rows, trajectory):   # only the rows of the fitted observables are corrected
             return calibrate(rows, model, target_itrs=apparent_itrs(trajectory, fm.ephemeris), ramps=data.store,
-                             catalog=catalog, order=None if cal.smoothing_order < 0 else cal.smoothing_order)[0]
+                             catalog=catalog, order=None if cal.smoothing_order < 0 else cal.smoothing_order,
+                             rows=fitted_rows(rows, cfg.data.observables))[0]
 
         table = media(table, apriori)
         log(f"calibrate: media on {int(np.isfinite(table['media_m']).sum())} rows; "
