@@ -6,7 +6,7 @@ Runs the arc's configuration like ``odpipe run`` (``force``: always fitted again
 sampling thread reads the main thread's Python stack every ``interval`` seconds. Each
 interval's wall time goes to the innermost frame that belongs to a stage:
 
-    ingest          parsers/, odpipe/pipeline/ingest.py
+    ingest          parsers/ (but parsers/atomic.py), odpipe/pipeline/ingest.py
     media           odpipe/media/
     compression     odpipe/preprocess/compress.py
     editing         the rest of odpipe/preprocess/
@@ -14,7 +14,8 @@ interval's wall time goes to the innermost frame that belongs to a stage:
     light time      odpipe/measurements/ (light-time solution, observables and their partials)
     filter          odpipe/estimation/ and odpipe/od/ outside the two above
     smoother        odpipe/estimation/smoother.py
-    products        odpipe/products/, odpipe/operations/, odpipe/pipeline/fitted_trajectory.py, run.py:_products
+    products        odpipe/products/, odpipe/operations/, odpipe/pipeline/fitted_trajectory.py, run.py:_products,
+                    parsers/atomic.py (file writes)
     set-up          the rest of odpipe/pipeline (force model, a priori trajectory, geometry)
 
 Frames of odpipe/frames, odpipe/time, odpipe/environment, numpy, scipy and pandas are
@@ -26,7 +27,9 @@ on a loaded machine. Time inside ``odpipe.estimation.fit.fit`` is
 also split by (fit call, iteration, weight stage). numba compilation (none when its
 cache is warm: run twice) is reported apart. Integrations and force-model evaluations
 (``Trajectory.n_eval``, independent of the machine's load) are counted by where
-``propagate`` was called from. ``--cprofile N`` also runs cProfile on the CPU clock
+``propagate`` was called from. BLAS runs one thread unless the environment says otherwise, as
+in the nightly's Dask workers (two BLAS threads on a loaded 2-core machine cost the media's
+per-pass polynomial fits ten times the CPU). ``--cprofile N`` also runs cProfile on the CPU clock
 (``time.process_time``) and prints its N functions of most cumulative CPU time (the sampler's
 figures then include cProfile's own overhead). Figures are printed, never asserted.
 """
@@ -35,6 +38,7 @@ from __future__ import annotations
 
 import argparse
 import cProfile
+import os
 import pstats
 import sys
 import threading
@@ -44,12 +48,15 @@ from pathlib import Path
 
 ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT))
+for _var in ("OPENBLAS_NUM_THREADS", "OMP_NUM_THREADS", "MKL_NUM_THREADS"):   # as in a nightly's Dask workers
+    os.environ.setdefault(_var, "1")
 
 from odpipe.dynamics.compile_timer import compile_timer  # noqa: E402
 from odpipe.pipeline.run import run_config  # noqa: E402
 from odpipe.operations.schema import ConfigError  # noqa: E402
 
 STAGES = [  # (path fragment, stage): the first fragment found in a frame's file name wins
+    ("/parsers/atomic.py", "products"),   # the products' atomic file writes
     ("/parsers/", "ingest"), ("/odpipe/pipeline/ingest.py", "ingest"),
     ("/odpipe/media/", "media"),
     ("/odpipe/preprocess/compress.py", "compression"), ("/odpipe/preprocess/", "editing"),
