@@ -45,6 +45,7 @@ from odpipe.operations import rundir
 from odpipe.operations.schema import ConfigError
 from odpipe.operations.report import Section, write_report
 from odpipe.time import tdb_to_utc
+from odpipe.tracking import ramp_segments
 from parsers.ionex import read_ionex
 from parsers.trk223 import read_trk223
 
@@ -136,14 +137,15 @@ def _run(cfg: RunConfig, attempt, log: RunLog, fingerprint: dict) -> dict:
     pre = cfg.preprocess
     rtlt = median_round_trip(table)
     n_raw = len(table)
-    table, creport = compress(table, pre.count_time, ramps=data.ramps, partial=pre.partial, ramp_delay=rtlt)
+    ramps = ramp_segments.store(data.ramps)   # compression's and editing's view of the ramps, built once
+    table, creport = compress(table, pre.count_time, ramps=ramps, partial=pre.partial, ramp_delay=rtlt)
     log(f"compress: {n_raw} rows -> {len(table)} at {pre.count_time:g} s count time")
     table = table[fitted_rows(table, cfg.data.observables)].reset_index(drop=True)  # after: counts -> Hz
     log(f"observables fitted: {', '.join(f'{k} {v}' for k, v in table['observable'].value_counts().items())}")
     edit_cfg = EditConfig(min_elevation=np.radians(pre.elevation_mask_deg), blunder_k=pre.blunder_k,
                           min_pass_samples=pre.min_pass_samples, windows=[vars(w) for w in pre.edit_windows],
                           arc=(np.datetime64(cfg.arc.start, "ns"), np.datetime64(cfg.arc.end, "ns")))
-    table, edits = edit(table, data.ramps, edit_cfg)
+    table, edits = edit(table, ramps, edit_cfg)
     log("edit: " + ", ".join(f"{r} {n}" for r, n in zip(edits["reason"], edits["rows"]) if n))
     before = table.iloc[:0]   # rows edited before the fit by a test on the rows it is given (per-station counts)
     if pre.apriori_blunder_k is not None:
