@@ -60,8 +60,9 @@ def calibrate(table: pd.DataFrame, model: MediaModel, *, target_itrs=None, ramps
 
     ``ramps``: the uplink ramp table (or RampStore) beside the table, giving ramped rows their
     uplink frequency at transmission; ``order=None`` disables per-pass smoothing. ``rows``: a boolean
-    mask of the rows to correct (default all); the others get none and a note saying so. Passes never
-    mix observables, so a row's correction is the same whether the other rows are corrected or not.
+    mask of the rows to correct (default all); the others get none and a note saying so. Where passes
+    hold one observable each (as :func:`assign_passes` makes them), a corrected row's value does not
+    depend on which other rows are corrected.
     """
     catalog = catalog or StationCatalog.default()
     out = table.copy()
