@@ -1,12 +1,12 @@
 """Where a GRAIL-B daily arc spends its time: wall and CPU seconds by pipeline stage and by fit iteration.
 
-    python benchmarks/profile_grail_arc.py [runs/grail_b_2012_04_10.toml] [--interval 0.002]
+    python benchmarks/profile_grail_arc.py [runs/grail_b_2012_04_10.toml] [--interval 0.002] [--cprofile N]
 
 Runs the arc's configuration like ``odpipe run`` (``force``: always fitted again) while a
 sampling thread reads the main thread's Python stack every ``interval`` seconds. Each
 interval's wall time goes to the innermost frame that belongs to a stage:
 
-    ingest          parsers/, odpipe/pipeline/ingest.py
+    ingest          parsers/ (but parsers/atomic.py), odpipe/pipeline/ingest.py
     media           odpipe/media/
     compression     odpipe/preprocess/compress.py
     editing         the rest of odpipe/preprocess/
@@ -14,7 +14,8 @@ interval's wall time goes to the innermost frame that belongs to a stage:
     light time      odpipe/measurements/ (light-time solution, observables and their partials)
     filter          odpipe/estimation/ and odpipe/od/ outside the two above
     smoother        odpipe/estimation/smoother.py
-    products        odpipe/products/, odpipe/operations/, odpipe/pipeline/fitted_trajectory.py, run.py:_products
+    products        odpipe/products/, odpipe/operations/, odpipe/pipeline/fitted_trajectory.py, run.py:_products,
+                    parsers/atomic.py (file writes)
     set-up          the rest of odpipe/pipeline (force model, a priori trajectory, geometry)
 
 Frames of odpipe/frames, odpipe/time, odpipe/environment, numpy, scipy and pandas are
@@ -26,12 +27,19 @@ on a loaded machine. Time inside ``odpipe.estimation.fit.fit`` is
 also split by (fit call, iteration, weight stage). numba compilation (none when its
 cache is warm: run twice) is reported apart. Integrations and force-model evaluations
 (``Trajectory.n_eval``, independent of the machine's load) are counted by where
-``propagate`` was called from. Figures are printed, never asserted.
+``propagate`` was called from. BLAS runs one thread unless the environment says otherwise, as
+in the nightly's Dask workers (two BLAS threads on a loaded 2-core machine cost the media's
+per-pass polynomial fits ten times the CPU). ``--cprofile N`` also runs cProfile on the CPU clock
+(``time.process_time``) and prints its N functions of most cumulative CPU time (the sampler's
+figures then include cProfile's own overhead). Figures are printed, never asserted.
 """
 
 from __future__ import annotations
 
 import argparse
+import cProfile
+import os
+import pstats
 import sys
 import threading
 import time
@@ -40,12 +48,15 @@ from pathlib import Path
 
 ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT))
+for _var in ("OPENBLAS_NUM_THREADS", "OMP_NUM_THREADS", "MKL_NUM_THREADS"):   # as in a nightly's Dask workers
+    os.environ.setdefault(_var, "1")
 
 from odpipe.dynamics.compile_timer import compile_timer  # noqa: E402
 from odpipe.pipeline.run import run_config  # noqa: E402
 from odpipe.operations.schema import ConfigError  # noqa: E402
 
 STAGES = [  # (path fragment, stage): the first fragment found in a frame's file name wins
+    ("/parsers/atomic.py", "products"),   # the products' atomic file writes
     ("/parsers/", "ingest"), ("/odpipe/pipeline/ingest.py", "ingest"),
     ("/odpipe/media/", "media"),
     ("/odpipe/preprocess/compress.py", "compression"), ("/odpipe/preprocess/", "editing"),
@@ -157,16 +168,24 @@ def main(argv=None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("config", nargs="?", type=Path, default=ROOT / "runs" / "grail_b_2012_04_10.toml")
     ap.add_argument("--interval", type=float, default=0.002, help="sampling interval, s")
+    ap.add_argument("--cprofile", type=int, default=0, metavar="N",
+                    help="also profile with cProfile on the CPU clock and print its top N functions")
     args = ap.parse_args(argv)
+    profiler = cProfile.Profile(time.process_time) if args.cprofile else None
     sampler = Sampler(threading.get_ident(), args.interval)
     sampler.start()
     t0, c0 = time.perf_counter(), time.process_time()
     try:
         with compile_timer() as ct, Integrations() as integ:
+            if profiler is not None:
+                profiler.enable()
             summary = run_config(args.config, force=True, progress=None)
     except ConfigError as exc:
         print(exc)
         return 1
+    finally:
+        if profiler is not None:
+            profiler.disable()
     wall, cpu = time.perf_counter() - t0, time.process_time() - c0
     sampler.stop.set()
     sampler.join()
@@ -190,6 +209,9 @@ def main(argv=None) -> int:
         print(f"{key:30s} {calls:6d} {evals:18d}")
     print(f"{'total':30s} {sum(c for c, _ in integ.count.values()):6d} "
           f"{sum(e for _, e in integ.count.values()):18d}")
+    if profiler is not None:
+        print("\ncProfile, CPU seconds")
+        pstats.Stats(profiler).sort_stats("cumulative").print_stats(args.cprofile)
     return 0
 
 

@@ -87,6 +87,23 @@ def test_round_trip_recovers_truth(cal):
 
 
 @pytest.mark.realdata
+def test_rows_not_asked_for_get_no_correction_and_the_others_the_same(cal):
+    """A run corrects only the rows of its fitted observables: those keep the corrections of the
+    round trip above (with per-pass smoothing, since passes never mix observables), the others none."""
+    tab = _table(n=60)
+    asked = (tab["observable"] == "doppler_2way").to_numpy()
+    full, _ = calibrate(tab, MediaModel(cal), target_itrs=target)
+    part, report = calibrate(tab, MediaModel(cal), target_itrs=target, rows=asked)
+    for col in ("tropo_m", "iono_m", "media_m"):
+        np.testing.assert_allclose(part.loc[asked, col], full.loc[asked, col], rtol=0, atol=1e-12)
+        assert np.isnan(part.loc[~asked, col]).all() and np.isfinite(full.loc[~asked, col]).all()
+    assert (part.loc[~asked, "media_note"] == "row not asked for: no correction").all()
+    assert (part.loc[asked, "media_note"].astype(str) == full.loc[asked, "media_note"].astype(str)).all()
+    assert (part.loc[~asked, "media_source"] == "").all()
+    assert report.loc[report["observable"] == "range", "notes"].eq("row not asked for: no correction").all()
+
+
+@pytest.mark.realdata
 def test_pass_without_calibrations_is_flagged_with_fallback(cal):
     # 2007: outside every card -> DSN seasonal troposphere, no ionosphere; said per row and per pass
     tab = _table(n=10, start="2007-02-27T04:00")

@@ -2,8 +2,12 @@
 
 The Butcher tableau, error weights and dense-output coefficients are the
 published DOP853 constants (Hairer, Norsett & Wanner, Solving ODE I), taken
-from scipy's coefficient table so they are typed nowhere here. The step-size
-controller and 3/5-order error norm follow Hairer's DOP853. The error norm
+from scipy's coefficient table so they are typed nowhere here. The 3/5-order
+error norm and the step-size controller follow Hairer's DOP853: the next step is
+h * 0.9 * err^(-1/8), kept within [0.333, 6] times the last one, never longer than
+the rejected one right after a rejection, and stretched by up to 1 % to land on t1.
+The last stage, f at the step's end (the next step's first), is evaluated only once
+a step is accepted. The error norm
 covers the first ``n_err`` components only (the state; the variational part
 rides on the same steps). ``rtol = inf`` takes fixed steps of ``h_max`` (the last one
 shorter to land on t1) without error control, the way onboard filters integrate.
@@ -32,7 +36,15 @@ D = np.ascontiguousarray(_dop.D, dtype=float)
 N_STAGES = _dop.N_STAGES  # 12
 N_EXT = _dop.N_STAGES_EXTENDED  # 16
 
-SAFETY, MIN_FACTOR, MAX_FACTOR = 0.9, 0.2, 10.0
+SAFETY, MIN_FACTOR, MAX_FACTOR = 0.9, 0.333, 6.0   # Hairer's safe, fac1, fac2: h_new / h in [fac1, fac2]
+
+
+@njit(cache=True)
+def _step_factor(err):
+    """h_new / h for the error norm ``err`` of the last step (accepted or not)."""
+    if err == 0.0:
+        return MAX_FACTOR
+    return min(MAX_FACTOR, max(MIN_FACTOR, SAFETY * err ** (-1.0 / 8.0)))
 
 
 @njit(cache=True)
@@ -43,7 +55,7 @@ def _error_norm(K, h, y, y_new, rtol, atol, n_err):
         sc = atol + rtol * max(abs(y[i]), abs(y_new[i]))
         s5 = 0.0
         s3 = 0.0
-        for s in range(N_STAGES + 1):
+        for s in range(N_STAGES):   # the weights' last entry, of f at the step's end, is zero
             s5 += E5[s] * K[s, i]
             s3 += E3[s] * K[s, i]
         e5 += (s5 / sc) ** 2
@@ -101,11 +113,12 @@ def integrate(model, t0, y0, t1, rtol, atol, h_max, n_err):
     fixed = rtol == np.inf                       # fixed steps of h_max, no error control
     h_abs = 1e-6 if (d0 < 1e-5 or d1 < 1e-5) else 0.01 * d0 / d1
     h_abs = min(h_max if fixed else h_abs, h_max, span)
+    rejected = False
     while True:
         remaining = abs(t1 - t)
         if remaining <= 1e-12 * max(1.0, abs(t1)):
             break
-        if h_abs > remaining:
+        if h_abs * (1.0 if fixed else 1.01) >= remaining:
             h_abs = remaining
         h = direction * h_abs
         for s in range(1, N_STAGES):
@@ -117,19 +130,20 @@ def integrate(model, t0, y0, t1, rtol, atol, h_max, n_err):
                 acc += B[s] * K[s, i]
             y_new[i] = y[i] + h * acc
         t_new = t + h if h_abs < remaining else t1
-        derivative(t_new, y_new, model, K[N_STAGES])
-        n_eval += N_STAGES
+        n_eval += N_STAGES - 1
         err = 0.0 if fixed else _error_norm(K, h, y, y_new, rtol, atol, n_err)
         if err > 1.0:
-            h_abs *= max(MIN_FACTOR, SAFETY * err ** (-1.0 / 8.0))
+            h_abs *= _step_factor(err)
+            rejected = True
             if h_abs < 1e-10 * max(1.0, abs(t)):
                 raise RuntimeError("DOP853: step size underflow")
             continue
-        # accepted: dense output needs three more stages
+        # accepted: f at the step's end, then three more stages for the dense output
+        derivative(t_new, y_new, model, K[N_STAGES])
         for s in range(N_STAGES + 1, N_EXT):
             _stage(K, y, h, s, ytmp)
             derivative(t + C[s] * h, ytmp, model, K[s])
-        n_eval += N_EXT - N_STAGES - 1
+        n_eval += N_EXT - N_STAGES
         if k + 1 >= cap:
             cap *= 2
             ts2 = np.empty(cap)
@@ -155,8 +169,9 @@ def integrate(model, t0, y0, t1, rtol, atol, h_max, n_err):
         ts[k] = t
         ys[k] = y
         K[0] = K[N_STAGES]
-        factor = MAX_FACTOR if err == 0.0 else min(MAX_FACTOR, SAFETY * err ** (-1.0 / 8.0))
-        h_abs = min(h_abs * factor, h_max)
+        factor = _step_factor(err)
+        h_abs = min(h_abs * (min(factor, 1.0) if rejected else factor), h_max)
+        rejected = False
     return ts[: k + 1].copy(), ys[: k + 1].copy(), Fs[:k].copy(), n_eval
 
 

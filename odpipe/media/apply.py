@@ -51,14 +51,18 @@ TWO_LEG = ("range", "doppler_2way", "doppler_3way")
 GROUND = TWO_LEG + ("doppler_1way",)
 NOT_GROUND = "not a ground radiometric observable: no correction"
 NO_VALUE = "no correction computed"
+NOT_ASKED = "row not asked for: no correction"
 
 
 def calibrate(table: pd.DataFrame, model: MediaModel, *, target_itrs=None, ramps=None,
-              catalog: StationCatalog | None = None, order: int | None = 10):
+              catalog: StationCatalog | None = None, order: int | None = 10, rows=None):
     """(table with media columns, per-pass coverage report).
 
     ``ramps``: the uplink ramp table (or RampStore) beside the table, giving ramped rows their
-    uplink frequency at transmission; ``order=None`` disables per-pass smoothing.
+    uplink frequency at transmission; ``order=None`` disables per-pass smoothing. ``rows``: a boolean
+    mask of the rows to correct (default all); the others get none and a note saying so. Where passes
+    hold one observable each (as :func:`assign_passes` makes them), a corrected row's value does not
+    depend on which other rows are corrected.
     """
     catalog = catalog or StationCatalog.default()
     out = table.copy()
@@ -68,6 +72,7 @@ def calibrate(table: pd.DataFrame, model: MediaModel, *, target_itrs=None, ramps
     # a running Doppler count is a Doppler row of its mode (its interval: since the previous count)
     obs = np.char.replace(out["observable"].to_numpy(dtype=str), "doppler_count_", "doppler_").astype(object)
     ground = np.isin(obs, GROUND)
+    wanted = np.ones(n, bool) if rows is None else np.asarray(rows, bool)
     doppler = np.char.startswith(obs.astype(str), "doppler")
     epoch = out["epoch"].to_numpy().astype("datetime64[ns]").view(np.int64)
     ct = np.where(doppler, out["count_time"].to_numpy(dtype=float), 0.0)
@@ -77,7 +82,7 @@ def calibrate(table: pd.DataFrame, model: MediaModel, *, target_itrs=None, ramps
     # rows without geometry (NaN light time) get no direction either, so no correction: 0 is a placeholder
     rtlt_ns = np.rint(np.nan_to_num(rtlt) * 1e9).astype(np.int64)
     f_up, f_down, f_up_known = _frequencies(out, epoch - rtlt_ns, ramps)
-    s = _samples(out, obs, ground, doppler, epoch, start, end, rtlt_ns, f_up, f_down)
+    s = _samples(out, obs, ground & wanted, doppler, epoch, start, end, rtlt_ns, f_up, f_down)
     tropo, iono, lab_t, lab_i = _leg_delays(s, out, model, target_itrs, catalog)
     if order is not None and len(s):
         group = pd.MultiIndex.from_arrays([s["pass_id"], s["leg"], s["station"]]).codes
@@ -87,8 +92,8 @@ def calibrate(table: pd.DataFrame, model: MediaModel, *, target_itrs=None, ramps
         iono = smooth_by_group(tsec, iono, key, order)
     iono = np.where(s["phase"].to_numpy(), -iono, iono)
     rows, sign = s["row"].to_numpy(), s["sign"].to_numpy()
-    out["tropo_m"] = _row_sum(n, rows, sign * tropo, ground)
-    out["iono_m"] = _row_sum(n, rows, sign * iono, ground)
+    out["tropo_m"] = _row_sum(n, rows, sign * tropo, ground & wanted)
+    out["iono_m"] = _row_sum(n, rows, sign * iono, ground & wanted)
     out["media_m"] = out["tropo_m"] + out["iono_m"]
     is_range = obs == "range"
     bands, band_idx = np.unique(out["band_up"].to_numpy(dtype=str), return_inverse=True)
@@ -101,7 +106,7 @@ def calibrate(table: pd.DataFrame, model: MediaModel, *, target_itrs=None, ramps
         row_code = np.full(n, len(texts) - 1)
         row_code[rows[pick]] = code[pick]
         out[col] = pd.Categorical(texts[row_code])
-    out["media_note"] = _notes(n, rows, code, texts.astype(str), ground, np.isin(obs, TWO_LEG), rtlt_note)
+    out["media_note"] = _notes(n, rows, code, texts.astype(str), ground, np.isin(obs, TWO_LEG), rtlt_note, wanted)
     return out, pass_report(out)
 
 
@@ -228,8 +233,9 @@ def _optical(table, rows, elevation, lat, h):
 def _direction(station, t, table, target_itrs, st):
     """(azimuth, elevation) rad at a station at UTC times from the target or the table's columns."""
     if target_itrs is not None:
-        az, el, _ = topocentric(st, np.asarray(target_itrs(t)), t)
-        return az, el
+        u, back = np.unique(t, return_inverse=True)   # a count's end is the next one's start
+        az, el, _ = topocentric(st, np.asarray(target_itrs(u)), u)
+        return az[back], el[back]
     if "elevation_rx" not in table.columns:
         return np.full(t.size, np.nan), np.full(t.size, np.nan)
     rows = table[table["station_rx"] == station]
@@ -253,7 +259,7 @@ def _row_sum(n, rows, values, ground):
     return np.where(ground & ~bad, out, np.nan)
 
 
-def _notes(n, rows, code, texts, ground, two_leg, rtlt_note):
+def _notes(n, rows, code, texts, ground, two_leg, rtlt_note, wanted):
     """Per row: why its correction is partial or a fallback (from every sample's source text)."""
     reasons = [("(no TRO)", "no TRO coverage: DSN seasonal model used"),
                ("standard-atmosphere", "non-DSN station: standard atmosphere used"),
@@ -265,7 +271,7 @@ def _notes(n, rows, code, texts, ground, two_leg, rtlt_note):
     for k, (flag, _) in enumerate(reasons):
         hit = (np.char.find(texts, flag) >= 0)[code]
         np.bitwise_or.at(bits, rows[hit], 1 << k)
-    extra = [(two_leg, rtlt_note), (~ground, NOT_GROUND)]
+    extra = [(two_leg & wanted, rtlt_note), (~ground, NOT_GROUND), (ground & ~wanted, NOT_ASKED)]
     for k, (mask, _) in enumerate(extra, len(reasons)):
         bits |= np.where(mask, 1 << k, 0)
     words = [text for _, text in reasons] + [text for _, text in extra]
@@ -283,9 +289,20 @@ def pass_report(t: pd.DataFrame) -> pd.DataFrame:
         "rows": g.size(),
         "start": g["epoch"].min(),
         "end": g["epoch"].max(),
-        "sources": g["media_source"].agg(lambda x: " || ".join(sorted(set(x)))),
-        "notes": g["media_note"].agg(lambda x: "; ".join(sorted({p for v in x for p in v.split("; ") if p}))),
+        "sources": _joined(t["pass_id"], t["media_source"], " || ", None),
+        "notes": _joined(t["pass_id"], t["media_note"], "; ", "; "),
     }).reset_index()
+
+
+def _joined(pass_id: pd.Series, text: pd.Series, sep: str, split: str | None) -> pd.Series:
+    """Per pass: the distinct values of ``text`` (each cut at ``split`` first, empty parts dropped), sorted
+    and joined with ``sep``; each distinct value of a pass is handled once."""
+    pairs = pd.DataFrame({"pass_id": pass_id.to_numpy(), "text": text.astype(str).to_numpy()}).drop_duplicates()
+    if split is not None:
+        pairs = pairs.assign(text=pairs["text"].str.split(split)).explode("text")
+        pairs = pairs[pairs["text"] != ""].drop_duplicates()
+    return pairs.sort_values("text", kind="stable").groupby("pass_id", sort=True)["text"].agg(sep.join).reindex(
+        pd.Index(np.unique(pass_id.to_numpy()), name="pass_id"), fill_value="")
 
 
 def fallbacks(t: pd.DataFrame) -> pd.DataFrame:

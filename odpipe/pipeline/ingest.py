@@ -6,6 +6,8 @@ ramps beside it), so any stage's output can feed a run. In ``errors="report"``
 mode a corrupt record is reported with its file and offset and skipped; a file
 no reader recognises is reported and skipped; nothing else is lost. Files that
 name no spacecraft (Orekit's ``.aer`` tables) have their rows given the run's.
+A process keeps the last few files it read (keyed by path, size and modification
+time), so the arcs of a nightly that share a day's file parse it once per worker.
 """
 
 from __future__ import annotations
@@ -30,7 +32,25 @@ class Ingested:
     log: list[str] = field(default_factory=list)
 
 
+_READ: dict = {}    # (path, size, mtime ns, errors) -> what _read returned; never modified by ingest
+_KEEP = 8           # files kept per process
+
+
 def _read(path: Path, errors: str) -> TrackingData:
+    try:
+        stat = Path(path).stat()
+    except OSError:   # the readers say why, naming the file
+        return _parse(path, errors)
+    key = (str(Path(path).resolve()), stat.st_size, stat.st_mtime_ns, errors)
+    if key not in _READ:
+        data = _parse(path, errors)
+        while len(_READ) >= _KEEP:
+            _READ.pop(next(iter(_READ)))
+        _READ[key] = data
+    return _READ[key]
+
+
+def _parse(path: Path, errors: str) -> TrackingData:
     if path.suffix == ".parquet":
         table, ramps = table_store.read(path)
         return TrackingData(table, ramps)

@@ -47,6 +47,7 @@ from odpipe.operations import rundir
 from odpipe.operations.schema import ConfigError
 from odpipe.operations.report import Section, write_report
 from odpipe.time import tdb_to_utc
+from odpipe.tracking import ramp_segments
 from parsers.ionex import read_ionex
 from parsers.trk223 import read_trk223
 
@@ -65,11 +66,13 @@ class RunLog:
 
 
 def fitted_rows(table: pd.DataFrame, observables: list[str]) -> np.ndarray:
-    """Rows of the configured observables: "observable", or "observable:BAND" for one downlink band."""
+    """Rows of the configured observables: "observable", or "observable:BAND" for one downlink band; a
+    running Doppler count (``doppler_count_<mode>``) is the ``doppler_<mode>`` row it is compressed into."""
     keep = np.zeros(len(table), bool)
+    names = table["observable"].astype(str).str.replace("doppler_count_", "doppler_", regex=False).to_numpy()
     for entry in observables:
         obs, _, band = entry.partition(":")
-        sel = table["observable"].to_numpy() == obs
+        sel = names == obs
         keep |= sel & (table["band_down"].astype(str).to_numpy() == band) if band else sel
     return keep
 
@@ -122,9 +125,10 @@ def _run(cfg: RunConfig, attempt, log: RunLog, fingerprint: dict) -> dict:
         model = MediaModel(read_trk223(*cal.tro, *cal.ion) if (cal.tro or cal.ion) else None,
                            IonexModel(read_ionex(*cal.ionex)) if cal.ionex else None, cal.standard_troposphere)
 
-        def media(rows, trajectory):
+        def media(rows, trajectory):   # only the rows of the fitted observables are corrected
             return calibrate(rows, model, target_itrs=apparent_itrs(trajectory, fm.ephemeris), ramps=data.store,
-                             catalog=catalog, order=None if cal.smoothing_order < 0 else cal.smoothing_order)[0]
+                             catalog=catalog, order=None if cal.smoothing_order < 0 else cal.smoothing_order,
+                             rows=fitted_rows(rows, cfg.data.observables))[0]
 
         table = media(table, apriori)
         log(f"calibrate: media on {int(np.isfinite(table['media_m']).sum())} rows; "
@@ -140,14 +144,15 @@ def _run(cfg: RunConfig, attempt, log: RunLog, fingerprint: dict) -> dict:
             + "".join(f", {k} {v}" for k, v in table.loc[lock, "station_rx"].value_counts().sort_index().items()))
     rtlt = median_round_trip(table)
     n_raw = len(table)
-    table, creport = compress(table, pre.count_time, ramps=data.ramps, partial=pre.partial, ramp_delay=rtlt)
+    ramps = ramp_segments.store(data.ramps)   # compression's and editing's view of the ramps, built once
+    table, creport = compress(table, pre.count_time, ramps=ramps, partial=pre.partial, ramp_delay=rtlt)
     log(f"compress: {n_raw} rows -> {len(table)} at {pre.count_time:g} s count time")
     table = table[fitted_rows(table, cfg.data.observables)].reset_index(drop=True)  # after: counts -> Hz
     log(f"observables fitted: {', '.join(f'{k} {v}' for k, v in table['observable'].value_counts().items())}")
     edit_cfg = EditConfig(min_elevation=np.radians(pre.elevation_mask_deg), blunder_k=pre.blunder_k,
                           min_pass_samples=pre.min_pass_samples, windows=[vars(w) for w in pre.edit_windows],
                           arc=(np.datetime64(cfg.arc.start, "ns"), np.datetime64(cfg.arc.end, "ns")))
-    table, edits = edit(table, data.ramps, edit_cfg)
+    table, edits = edit(table, ramps, edit_cfg)
     if pre.range_uplink_epoch:
         table, removed = stale_uplink_range(table, data.ramps, pre.range_uplink_epoch)
         edits = flag_summary(table["flags"])
