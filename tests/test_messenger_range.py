@@ -19,7 +19,7 @@ import numpy as np
 import pandas as pd
 import pytest
 
-from odpipe.tracking.ramps_phase_epoch import into_segment
+from odpipe.preprocess.stale_uplink import into_segment
 from parsers import odf
 from parsers.ramps import RampStore
 

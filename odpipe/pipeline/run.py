@@ -39,7 +39,7 @@ from odpipe.preprocess.edit import EditConfig, edit
 from odpipe.preprocess.flags import Flag
 from odpipe.preprocess.flags import summary as flag_summary
 from odpipe.products import parameters, residuals
-from odpipe.tracking.ramps_phase_epoch import stale_uplink_range
+from odpipe.preprocess.stale_uplink import stale_uplink_range
 from parsers.atomic import write_parquet, write_text
 from odpipe.products.oem import write_oem
 from odpipe.products.spk import write_spk
