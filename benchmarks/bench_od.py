@@ -117,7 +117,7 @@ def peers_case():
     used = int((sol.residuals["flags"] == 0).sum())
     print(f"  default fit: {n_it} iterations (growing arcs included), converged={sol.converged}, {sol.problem.n_propagations} segment integrations")
     print(f"  wall time per iteration      {total / n_it:8.3f} s")
-    print(f"  total fit                    {total:8.3f} s   (lead, idle machine: Orekit 47.7 s, nyx 3.1 s diverged)")
+    print(f"  total fit                    {total:8.3f} s   (the peers on this case: ../shared/peers, README performance table)")
     print(f"  total fit, CPU time          {cpu:8.3f} s   (wall > CPU: the machine is shared)")
     print(f"  measurements/s               {len(sol.residuals) * n_it / total:8.0f}   ({used} rows used)")
     for h in sol.history:
