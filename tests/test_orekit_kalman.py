@@ -110,6 +110,25 @@ def _reference(cfg, t_tdb: float, clock: str = "TT") -> np.ndarray:
     return orbit.state(np.array([t_ref + dt]))[0]
 
 
+def _used_ranges(products):
+    """The 258 range rows the fit used."""
+    r = products.residuals
+    used = r.loc[(r["status"] == "") & (r["flags"] == 0) & (r["observable"] == "range")]
+    assert len(used) == 258
+    return used
+
+
+def _assert_like_orekits(values, stats):
+    """Residuals (m, Orekit's sign) against Orekit's statistics: the variance within chi-square bounds at
+    99.9 %, the mean within 3.29 standard errors, min and max within one std."""
+    n, std = len(values), stats["std"]
+    ratio = values.var(ddof=1) / std ** 2
+    assert chi2.ppf(0.0005, n - 1) / (n - 1) < ratio < chi2.ppf(0.9995, n - 1) / (n - 1)
+    assert abs(values.mean() - stats["mean"]) < 3.29 * std / np.sqrt(n)
+    assert abs(values.min() - stats["min"]) < std
+    assert abs(values.max() - stats["max"]) < std
+
+
 @pytest.mark.realdata
 def test_lageos2_kalman_run_matches_orekits_filter_and_smoother(tmp_path, shared_data):
     """Measured 2026-11-26 with Orekit's troposphere (modified Saastamoinen, its standard atmosphere),
@@ -158,16 +177,9 @@ def test_lageos2_kalman_run_matches_orekits_filter_and_smoother(tmp_path, shared
         assert d @ np.linalg.solve(cov, d) < chi2.ppf(0.999, 6)
 
     # the filter's residuals, each after its own update as Orekit's (one update per range epoch), Orekit's sign
-    r = products.residuals
-    used = r.loc[(r["status"] == "") & (r["flags"] == 0) & (r["observable"] == "range")]
-    assert len(used) == 258
+    used = _used_ranges(products)
     after_update = -(used["innovation"] * used["sigma"] ** 2 / used["innovation_sigma"] ** 2).to_numpy()
-    n, std = len(after_update), OREKIT_RANGE_STATS["std"]
-    ratio = after_update.var(ddof=1) / std ** 2
-    assert chi2.ppf(0.0005, n - 1) / (n - 1) < ratio < chi2.ppf(0.9995, n - 1) / (n - 1)
-    assert abs(after_update.mean() - OREKIT_RANGE_STATS["mean"]) < 3.29 * std / np.sqrt(n)
-    assert abs(after_update.min() - OREKIT_RANGE_STATS["min"]) < std
-    assert abs(after_update.max() - OREKIT_RANGE_STATS["max"]) < std
+    _assert_like_orekits(after_update, OREKIT_RANGE_STATS)
 
     # YARL's range bias, the only one as Orekit's (estimation.range_bias_stations), within odpipe's sigma of Orekit's
     names = products.parameters["name"]
@@ -200,16 +212,9 @@ def test_the_reference_is_orekits_batch_with_yarls_offsets_and_bias_free(tmp_pat
     issue's 1 m; the residuals as
     the Kalman test's; the state, offsets and bias inside the scaled covariance (99.9 %)."""
     cfg, products, sol = _run(tmp_path, shared_data, YARL_FREE)
-    r = products.residuals
-    used = r.loc[(r["status"] == "") & (r["flags"] == 0) & (r["observable"] == "range")]
-    assert len(used) == 258
+    used = _used_ranges(products)
     post = -used["postfit"].to_numpy()   # Orekit's sign: estimated minus observed
-    n, std = len(post), OREKIT_BATCH_RANGE_STATS["std"]
-    ratio = post.var(ddof=1) / std ** 2
-    assert chi2.ppf(0.0005, n - 1) / (n - 1) < ratio < chi2.ppf(0.9995, n - 1) / (n - 1)
-    assert abs(post.mean() - OREKIT_BATCH_RANGE_STATS["mean"]) < 3.29 * std / np.sqrt(n)
-    assert abs(post.min() - OREKIT_BATCH_RANGE_STATS["min"]) < std
-    assert abs(post.max() - OREKIT_BATCH_RANGE_STATS["max"]) < std
+    _assert_like_orekits(post, OREKIT_BATCH_RANGE_STATS)
 
     scale = post.std(ddof=1) / used["sigma"].to_numpy()   # the noise in units of the data sigma (20 m)
     assert np.allclose(scale, scale[0])
