@@ -21,7 +21,7 @@ from pathlib import Path
 from typing import Callable
 
 from odpipe.errors import describe
-from odpipe.operations.schema import checked, load, positive, read_toml
+from odpipe.operations.schema import checked, load_file, positive
 
 _log = logging.getLogger(__name__)
 
@@ -47,9 +47,7 @@ class BatchConfig:
 
 def load_batch(path) -> BatchSection:
     """The ``[batch]`` table of the batch configuration file ``path``, checked (ConfigError)."""
-    path = Path(path).resolve()
-    data, text = read_toml(path)
-    return load(BatchConfig, data, path, text=text).batch
+    return load_file(BatchConfig, path).batch
 
 
 @dataclass

@@ -95,6 +95,14 @@ def read_toml(path) -> tuple[dict, str]:
         raise ConfigError(path, "", f"not valid TOML: {exc}", line=int(line.group(1)) if line else None) from None
 
 
+def load_file(cls, path):
+    """Build dataclass ``cls`` from the TOML file ``path`` (resolved): one ConfigError naming the file and
+    every wrong key with its line."""
+    path = Path(path).resolve()
+    data, text = read_toml(path)
+    return load(cls, data, path, text=text)
+
+
 def load(cls, data: dict, path: Path, key: str = "", text: str | None = None):
     """Build dataclass ``cls`` from the TOML table ``data`` read from ``path`` (its ``text`` locates
     problems by line). Raises one ConfigError listing every problem."""

@@ -30,7 +30,7 @@ from odpipe.estimation.solution import Solution
 from odpipe.od.arc import build_registry
 from odpipe.od.multiarc import _SIGMA_FIELD, fit_multiarc, solution_share
 from odpipe.operations import rundir
-from odpipe.operations.schema import ConfigError, at_least, checked, file_name, load, positive, read_toml
+from odpipe.operations.schema import ConfigError, at_least, checked, file_name, load_file, positive
 from odpipe.pipeline import setup as build
 from odpipe.pipeline.config import load_config
 from odpipe.pipeline.fitted_trajectory import fitted_segments
@@ -62,9 +62,7 @@ class MultiArcConfig:
 
 def load_multiarc(path) -> MultiArcSection:
     """The ``[multiarc]`` table of ``path``, checked (ConfigError naming the key)."""
-    path = Path(path).resolve()
-    data, text = read_toml(path)
-    return load(MultiArcConfig, data, path, text=text).multiarc
+    return load_file(MultiArcConfig, path).multiarc
 
 
 @dataclass
