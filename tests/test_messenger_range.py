@@ -143,6 +143,9 @@ def test_uplink_epoch_sections_need_a_reason_and_an_order(tmp_path, shared_data)
     (tmp_path / "arc.toml").write_text(text.replace("into_ramp_s = 599.0", "into_ramp_s = -1.0", 1))
     with pytest.raises(ConfigError, match=r"preprocess\.range_uplink_epoch\[0\]\.into_ramp_s\] -1\.0 must be positive"):
         load_config(tmp_path / "arc.toml")
+    (tmp_path / "arc.toml").write_text(text.replace("into_ramp_s = 599.0\n", "", 1))   # measured per file: no default
+    with pytest.raises(ConfigError, match=r"preprocess\.range_uplink_epoch\[0\]\.into_ramp_s"):
+        load_config(tmp_path / "arc.toml")
 
 
 @pytest.mark.realdata

@@ -181,8 +181,8 @@ class UplinkEpochSection:
     start: str = checked(utc_time)  # UTC ISO time, first tag
     end: str = checked(utc_time)  # UTC ISO time, last tag
     reason: str  # what shows the rows read the uplink phase there, kept in the configuration
+    into_ramp_s: float = checked(positive)  # s after the start of the ramp record (measured per file: 599 in odf07155)
     station_rx: str = ""  # e.g. "DSS-14"; empty: every station
-    into_ramp_s: float = checked(positive, default=599.0)  # s after the start of the ramp record
 
     problems = EditWindowSection.problems
 
