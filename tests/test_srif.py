@@ -172,3 +172,53 @@ def test_accumulated_chi2_is_the_least_squares_cost():
     x = f.gaussian().x
     cost = np.sum(((y - H @ x) / 0.3) ** 2) + np.sum((x / sig0) ** 2)
     assert f.chi2 == pytest.approx(cost, rel=1e-10)
+
+
+def test_compiled_intervals_match_textbook_kalman_rts_and_edit_a_blunder():
+    """``SRIF.intervals`` (one compiled pass: marks, innovation test, updates, maps) against the textbook
+    covariance filter and RTS smoother without process noise: filtered and smoothed estimates and covariances
+    at every mark, each row's innovation and its predicted sigma (H P H^T + sigma^2), and a 20-sigma blunder
+    edited by the 5-sigma test (the covariance filter leaves that row out)."""
+    rng = np.random.default_rng(7)
+    Phi, _, _ = _system()
+    n, K = 7, 30
+    sig0 = np.array([100.0, 100.0, 1.0, 1.0, 1e-4, 1e-4, 5.0])
+    counts = rng.integers(0, 4, size=K)                       # uneven blocks, some empty
+    bounds = np.concatenate([[0], np.cumsum(counts)])
+    H = np.column_stack([rng.normal(size=(bounds[-1], 4)), np.zeros((bounds[-1], 2)), np.ones((bounds[-1], 1))])
+    sig_y = rng.uniform(0.5, 2.0, size=bounds[-1])
+    y = rng.normal(size=bounds[-1]) * sig_y
+    blunder = int(bounds[K // 2])
+    y[blunder] += 20 * np.sqrt(np.sum((H[blunder] * sig0) ** 2) + sig_y[blunder] ** 2)
+    f = SRIF.from_apriori(sig0, dx=rng.normal(size=n) * sig0 * 0.1)
+    x, P = f.gaussian().x.copy(), np.diag(sig0**2)
+    Rs, zs, nu, s, bad = f.intervals(0, np.repeat(Phi[None], K, 0), H, y, sig_y, np.ones(y.size, bool), bounds, 5.0)
+    f.mark(K)
+    sm = smooth(f)
+    xs_f, Ps_f, nu_kf, s_kf = [], [], np.empty(y.size), np.empty(y.size)
+    for k in range(K):
+        xs_f.append(x)
+        Ps_f.append(P)
+        r = slice(bounds[k], bounds[k + 1])
+        nu_kf[r] = y[r] - H[r] @ x
+        s_kf[r] = np.sqrt(np.einsum("ij,jk,ik->i", H[r], P, H[r]) + sig_y[r] ** 2)
+        keep = np.arange(bounds[k], bounds[k + 1]) != blunder
+        Hk, Rm = H[r][keep], np.diag(sig_y[r][keep] ** 2)
+        if len(Hk):
+            Kg = P @ Hk.T @ np.linalg.inv(Hk @ P @ Hk.T + Rm)
+            x = x + Kg @ (y[r][keep] - Hk @ x)
+            IKH = np.eye(n) - Kg @ Hk
+            P = IKH @ P @ IKH.T + Kg @ Rm @ Kg.T
+        x, P = Phi @ x, Phi @ P @ Phi.T
+    xs_f.append(x)
+    Ps_f.append(P)
+    Phi_inv = np.linalg.inv(Phi)
+    xsm, Psm = [x], [P]                                       # no process noise: the final estimate mapped back
+    for k in range(K - 1, -1, -1):
+        xsm.insert(0, Phi_inv @ xsm[0])
+        Psm.insert(0, Phi_inv @ Psm[0] @ Phi_inv.T)
+    filt = [SRIF(R, z).gaussian() for R, z in zip(Rs, zs)]
+    assert max(max(_rel(filt[k].x, xs_f[k]), _rel(filt[k].P, Ps_f[k])) for k in range(K)) < 1e-9
+    assert max(max(_rel(sm[k].x, xsm[k]), _rel(sm[k].P, Psm[k])) for k in range(K + 1)) < 1e-9
+    assert _rel(nu, nu_kf) < 1e-9 and _rel(s, s_kf) < 1e-9
+    assert np.flatnonzero(bad).tolist() == [blunder]

@@ -171,7 +171,10 @@ class _Pass:
     refs: list          # reference vector at each grid epoch (after any stochastic step)
     filtered: list      # filter information arrays (R, z) at each grid epoch
     smoothed: dict      # smoother information arrays (R, z) by grid index
-    blocks: list        # (grid index, rows, H, y) of each measurement block
+    rows: slice         # the rows inside the arc
+    k_row: np.ndarray   # grid index of each of those rows' interval
+    H: np.ndarray       # their partials w.r.t. the vector at that grid epoch
+    y: np.ndarray       # their pre-fit residuals
     flags: np.ndarray
     prefit: np.ndarray
     innovation: np.ndarray
@@ -183,6 +186,55 @@ def _unusable(obs: Observations) -> np.ndarray:
     return ~np.isfinite(obs.value) | ~np.isfinite(obs.sigma) | ~(obs.sigma > 0)
 
 
+@dataclass
+class _Sweep:
+    """The reference through the grid and the problem's answers along it (independent of the filter)."""
+
+    refs: list          # reference vector at each grid epoch (after any stochastic step), K + 1
+    Phi: np.ndarray     # (K, n, n) transition of each interval
+    computed: np.ndarray  # computed values of the rows bounds[0]:bounds[-1]
+    H: np.ndarray       # their partials w.r.t. the vector at their interval's start
+    noise: dict         # grid index -> [(idx, m, q, offset)] process-noise steps there
+
+
+def _sweep(problem, grid, steps, bounds, x_ref0, p_after) -> _Sweep:
+    """Fly the reference over the grid: the stochastic steps (their reference values from ``p_after``, else
+    ``m p``), each interval's rows (``problem.predict``) and transition. A problem with ``span`` answers the
+    intervals up to where its reference changes at once."""
+    K, n = grid.size - 1, x_ref0.size
+    lo0 = bounds[0]
+    Phi = np.empty((K, n, n))
+    computed, H = np.full(bounds[-1] - lo0, np.nan), np.zeros((bounds[-1] - lo0, n))
+    refs, noise = [], {}
+    span = getattr(problem, "span", None)
+    xr = x_ref0.copy()
+    k = 0
+    while k < K:
+        for j, (idx, (m, q)) in enumerate(steps.get(k, ())):
+            new = p_after.get((k, j), m * xr[idx])
+            noise.setdefault(k, []).append((idx, m, q, m * xr[idx] - new))
+            xr = xr.copy()
+            xr[idx] = new
+        lo, hi = bounds[k] - lo0, bounds[k + 1] - lo0
+        if span is not None:
+            end = next((e for e in sorted(steps) if e > k), K)
+            xs, Phi_k, c, H_k = span(grid[k:end + 1], xr, bounds[k:end + 1])
+            j = Phi_k.shape[0]
+            refs.extend(xs[:-1])
+            Phi[k:k + j] = Phi_k
+            hi = bounds[k + j] - lo0
+            computed[lo:hi], H[lo:hi] = c, H_k
+            xr, k = xs[-1], k + j
+            continue
+        refs.append(xr)
+        if hi > lo:
+            computed[lo:hi], H[lo:hi] = problem.predict(grid[k], xr, np.arange(lo + lo0, hi + lo0))
+        xr, Phi[k] = problem.transition(grid[k], grid[k + 1], xr)
+        k += 1
+    refs.append(xr)
+    return _Sweep(refs, Phi, computed, H, noise)
+
+
 def _filter_smoother_pass(problem, obs, grid, steps, bounds, x_ref0, p_after, sig_row, edit_k,
                           against_reference=False):
     reg = problem.registry
@@ -190,58 +242,32 @@ def _filter_smoother_pass(problem, obs, grid, steps, bounds, x_ref0, p_after, si
     flags = np.zeros(m_obs, int)
     flags[: bounds[0]] |= OUTSIDE_ARC
     flags[bounds[-1]:] |= OUTSIDE_ARC
-    unusable = _unusable(obs) | ~np.isfinite(sig_row) | ~(sig_row > 0)
-    prefit, innov, innov_sig = (np.full(m_obs, np.nan) for _ in range(3))
+    sw = _sweep(problem, grid, steps, bounds, x_ref0, p_after)
+    rows = slice(bounds[0], bounds[-1])
+    y = obs.value[rows] - sw.computed
+    sig = sig_row[rows]
+    unusable = _unusable(obs)[rows] | ~np.isfinite(sig) | ~(sig > 0)
+    use = ~(unusable | ~np.isfinite(y) | ~np.isfinite(sw.H).all(axis=1))
+    flags[rows][~use] |= NONFINITE
     srif = SRIF.from_apriori(reg.sigma, dx=reg.apriori - x_ref0, n_est=reg.n_estimated)
-    xr = x_ref0.copy()
-    refs, blocks, filt = [], [], []
     K = grid.size - 1
-    for k in range(K):
-        for j, (idx, (m, q)) in enumerate(steps.get(k, ())):
-            new = p_after.get((k, j), m * xr[idx])
-            srif.process_noise(idx, m, q, offset=m * xr[idx] - new)
-            xr = xr.copy()
-            xr[idx] = new
-        refs.append(xr)
-        srif.mark(k)
-        filt.append((srif.R, srif.z))
-        lo, hi = bounds[k], bounds[k + 1]
-        if hi > lo:
-            rows = np.arange(lo, hi)
-            computed, H = problem.predict(grid[k], xr, rows)
-            y = obs.value[lo:hi] - computed
-            sig = sig_row[lo:hi]
-            use = ~(unusable[lo:hi] | ~np.isfinite(y) | ~np.isfinite(H).all(axis=1))
-            if use.all():   # the usual block: every row computable
-                nu, s = srif.innovations(H, y, sig)
-                bad = np.abs(nu) > edit_k * s
-                if against_reference:
-                    bad &= np.abs(y) > edit_k * sig
-            else:
-                flags[lo:hi][~use] |= NONFINITE
-                nu, s = np.full(rows.size, np.nan), np.full(rows.size, np.nan)
-                nu[use], s[use] = srif.innovations(H[use], y[use], sig[use])
-                # an outlier to the forward filter that the last smoothed solution (the reference) fits too is
-                # no blunder, only a surprise (an unmodelled acceleration after a burn): edited it locks the
-                # filter out
-                bad = use.copy()
-                bad[use] = np.abs(nu[use]) > edit_k * s[use]
-                if against_reference:
-                    bad[use] &= np.abs(y[use]) > edit_k * sig[use]
-            flags[lo:hi][bad] |= EDIT_INNOVATION
-            prefit[lo:hi], innov[lo:hi], innov_sig[lo:hi] = y, nu, s
-            keep = use & ~bad
-            if keep.all():
-                srif.measurement_update(H, y, sig)
-            else:
-                srif.measurement_update(H[keep], y[keep], sig[keep])
-            blocks.append((k, rows, H, y))
-        xr, Phi = problem.transition(grid[k], grid[k + 1], xr)
-        srif.time_update(Phi)
-    refs.append(xr)
+    local = bounds - bounds[0]
+    nu, s, bad, filt = np.full(y.size, np.nan), np.full(y.size, np.nan), np.zeros(y.size, bool), []
+    cuts = sorted({0, K} | {k for k in sw.noise if k < K})
+    for k0, k1 in zip(cuts[:-1], cuts[1:]):
+        for idx, m, q, offset in sw.noise.get(k0, ()):
+            srif.process_noise(idx, m, q, offset=offset)
+        r = slice(local[k0], local[k1])
+        Rs, zs, nu[r], s[r], bad[r] = srif.intervals(k0, sw.Phi[k0:k1], sw.H[r], y[r], sig[r], use[r],
+                                                      local[k0:k1 + 1] - local[k0], edit_k, against_reference)
+        filt.extend(zip(Rs, zs))
     srif.mark(K)
     filt.append((srif.R, srif.z))
-    return _Pass(srif, refs, filt, smooth_arrays(srif), blocks, flags, prefit, innov, innov_sig)
+    flags[rows][bad] |= EDIT_INNOVATION
+    prefit, innov, innov_sig = (np.full(m_obs, np.nan) for _ in range(3))
+    prefit[rows], innov[rows], innov_sig[rows] = y, nu, s
+    k_row = np.repeat(np.arange(K), np.diff(local))
+    return _Pass(srif, sw.refs, filt, smooth_arrays(srif), rows, k_row, sw.H, y, flags, prefit, innov, innov_sig)
 
 
 def _symmetric(P) -> np.ndarray:
@@ -320,15 +346,17 @@ def fit(problem: Problem, obs: Observations, t_start: float, t_end: float,
                 for key, v in last_step[1].items():
                     p_after[key] -= v
                 halvings += 1
-        needed = {0} | {b[0] for b in ps.blocks} | set(steps)
+        needed = {0} | set(np.unique(ps.k_row).tolist()) | set(steps)
         dx = _estimates(ps, {k: ps.smoothed[k] for k in sorted(needed)})
         ok = ps.flags == 0
         if not ok.any():
             raise NothingToFit(_nothing_left(ps.flags, it))
         postfit = np.full(obs.time.size, np.nan)
-        for k, rows, H, y in ps.blocks:
+        if ps.k_row.size:
+            keys = np.array(sorted(needed))
+            dx_rows = np.array([dx[k] for k in keys])[np.searchsorted(keys, ps.k_row)]
             with np.errstate(invalid="ignore"):
-                postfit[rows] = y - H @ dx[k]
+                postfit[ps.rows] = ps.y - np.einsum("ij,ij->i", ps.H, dx_rows)
         postfit[(ps.flags & NONFINITE) != 0] = np.nan
         rms = float(np.sqrt(np.mean((postfit[ok] / sig_row[ok]) ** 2)))
         P0 = _gaussian(ps, *ps.smoothed[0]).P

@@ -2,7 +2,7 @@
 
 Runs backwards over an :class:`~odpipe.estimation.srif.SRIF` log, starting from
 the final filtered information array. A deterministic map ``dx+ = Phi dx`` is
-undone as ``R* <- R* Phi``; a colored-noise step combines the smoothed array of
+undone as ``R* <- R* Phi`` (a compiled run of them for :meth:`~.srif.SRIF.intervals`); a colored-noise step combines the smoothed array of
 ``dx+`` with the rows the filter eliminated (which tie ``p_old`` to ``dx+``) and
 marginalizes ``p_new``. Measurement updates need no backward work: between
 process-noise steps the smoothed estimate is the mapped final one.
@@ -13,6 +13,7 @@ from __future__ import annotations
 import numpy as np
 
 from .srif import SRIF, solve_information, triangularize
+from .srif_kernels import backward_maps
 
 
 def smooth(srif: SRIF) -> dict:
@@ -32,6 +33,11 @@ def smooth_arrays(srif: SRIF) -> dict:
             out[event[1]] = (R, z)
         elif kind == "map":
             R = R @ event[1]
+        elif kind == "intervals":   # marks first.. each followed by its map, undone at once
+            _, first, Phi = event
+            Rs = backward_maps(np.ascontiguousarray(R), Phi)
+            out.update({first + k: (Rs[k], z) for k in range(Phi.shape[0])})
+            R = Rs[0]
         else:
             _, idx, Rpp, Rpx, zp = event
             k = idx.size

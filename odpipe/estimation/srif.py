@@ -5,10 +5,13 @@ a reference, with ``R dx = z - nu``, ``nu ~ N(0, I)``. The vector is in registry
 canonical order: ``n_est`` estimated parameters, then consider parameters whose
 a priori (deviation ``c_bar``, sigma ``c_sigma``) is never replaced by data.
 
-Operations, all by Householder triangularization (LAPACK geqrf):
+Operations, all by Householder triangularization (LAPACK's reflections; the updates compiled in
+:mod:`.srif_kernels`, the rest by LAPACK geqrf):
 
 * :meth:`SRIF.measurement_update` -- rows ``H dx = y + eps``, ``eps ~ N(0, sigma^2)``;
 * :meth:`SRIF.time_update` -- deterministic map ``dx+ = Phi dx``;
+* :meth:`SRIF.intervals` -- grid intervals without process noise in one compiled pass: marks,
+  measurement blocks after an innovation test, maps;
 * :meth:`SRIF.process_noise` -- Bierman's colored-noise update of stochastic
   parameters ``p+ = m p + w`` at one instant (m = 0 white, 0 < m < 1
   Gauss-Markov, m = 1 random walk); its eliminated rows are kept for the smoother.
@@ -23,7 +26,9 @@ from dataclasses import dataclass
 from functools import lru_cache
 
 import numpy as np
-from scipy.linalg.lapack import dgeqrf, dgesv, dtrtri
+from scipy.linalg.lapack import dgeqrf, dtrtri
+
+from . import srif_kernels as kernels
 
 
 @lru_cache(maxsize=64)
@@ -63,6 +68,11 @@ def _augmented(R, z) -> np.ndarray:
     A[..., :-1] = R
     A[..., -1] = z
     return A
+
+
+def _rows(a) -> np.ndarray:
+    """``a`` as a C-contiguous float64 array (the compiled kernels' one signature)."""
+    return np.ascontiguousarray(a, dtype=float)
 
 
 def _inverse(R):
@@ -158,34 +168,37 @@ class SRIF:
     def n(self) -> int:
         return self.R.shape[1]
 
-    def _set(self, T):
-        self.R, self.z = T[: self.n, : self.n], T[: self.n, self.n]
-
     # -- updates ---------------------------------------------------------
     def measurement_update(self, H, y, sigma) -> float:
         """Absorb rows ``H dx = y`` with noise ``sigma``; return their contribution to
         the whitened residual sum of squares (also accumulated in ``chi2``)."""
-        w = 1.0 / np.asarray(sigma, float)
-        H = np.atleast_2d(H)
-        n = self.n
-        A = np.empty((n + H.shape[0], n + 1))
-        A[:n, :n] = self.R
-        A[:n, n] = self.z
-        A[n:, :n] = H * w[:, None]
-        A[n:, n] = np.asarray(y) * w
-        T = triangularize(A)
-        self._set(T)
-        e2 = float(T[self.n, self.n] ** 2) if T.shape[0] > self.n else 0.0
+        H = _rows(np.atleast_2d(H))
+        self.R, self.z, e2 = kernels.absorb(_rows(self.R), _rows(self.z), H, _rows(y), 1.0 / _rows(sigma))
         self.chi2 += e2
         return e2
 
     def time_update(self, Phi):
         """Deterministic map ``dx+ = Phi dx`` (Phi invertible, n x n)."""
-        lu, piv, RPhiInvT, info = dgesv(Phi.T, self.R.T)
-        if info != 0:
-            raise np.linalg.LinAlgError("singular transition matrix")
-        self._set(triangularize(_augmented(RPhiInvT.T, self.z)))
+        Phi = _rows(Phi)
+        self.R, self.z = kernels.mapped(_rows(self.R), _rows(self.z), Phi)
         self.log.append(("map", Phi))
+
+    def intervals(self, first, Phi, H, y, sigma, use, bounds, edit_k, edit_y=False):
+        """Grid intervals ``first, first + 1, ...`` without process noise, in one compiled pass: at each, a
+        ``mark``, the rows ``bounds[k]:bounds[k + 1]`` of ``H dx = y`` (noise ``sigma``; those with ``use``)
+        absorbed unless the innovation test edits them (``|nu| > edit_k s``, and with ``edit_y`` also
+        ``|y| > edit_k sigma``), and the map ``Phi[k]`` (K, n, n).
+
+        Returns the information arrays at the marks ((K, n, n), (K, n)) and per row the innovation nu,
+        its predicted sigma s (NaN where not ``use``) and whether it was edited."""
+        Phi = _rows(Phi)
+        Rs, zs, self.R, self.z, nu, s, bad, chi2 = kernels.filter_intervals(
+            _rows(self.R), _rows(self.z), Phi, _rows(H), _rows(y), _rows(sigma), np.ascontiguousarray(use, bool),
+            bool(edit_y), np.ascontiguousarray(bounds, np.int64), float(edit_k), self.n_est, _rows(self.c_bar),
+            _rows(self.c_sigma))
+        self.chi2 += chi2
+        self.log.append(("intervals", first, Phi))
+        return Rs, zs, nu, s, bad
 
     def process_noise(self, idx, m, q, offset=None):
         """Colored-noise step ``p+ = m p + offset + w``, ``w ~ N(0, q)`` on parameters ``idx``.
@@ -228,14 +241,8 @@ class SRIF:
         The prediction variance includes the estimate's covariance with the
         consider parameters' effect, and the measurement noise.
         """
-        H = np.atleast_2d(H)
-        if self.n_est == self.n:        # H P H^T = |R^-T H^T|^2, no covariance needed
-            Rinv = _inverse(self.R)
-            x = Rinv @ self.z
-            hph = np.sum((H @ Rinv) ** 2, axis=1)
-        else:
-            g = self.gaussian()
-            x = g.x
-            hph = np.sum((H @ g.P_consider) * H, axis=1)
-        nu = np.asarray(y) - H @ x
-        return nu, np.sqrt(hph + np.asarray(sigma, float) ** 2)
+        H = _rows(np.atleast_2d(H))
+        nu, s = np.empty(H.shape[0]), np.empty(H.shape[0])
+        kernels.innovations(_rows(self.R), _rows(self.z), H, _rows(y), _rows(sigma), np.ones(H.shape[0], bool),
+                            self.n_est, _rows(self.c_bar), _rows(self.c_sigma), nu, s)
+        return nu, s

@@ -385,6 +385,33 @@ class TrackingProblem:
         self._last = (seg, x1)
         return x1, Phi
 
+    def span(self, epochs, x0, bounds):
+        """:meth:`predict` and :meth:`transition` over the grid intervals from ``epochs[0]`` (reference ``x0``)
+        up to ``epochs[-1]`` or the segment's end, at once: (references at the J + 1 epochs (J + 1, n),
+        Phi (J, n, n), computed values and H of the rows ``bounds[0]:bounds[J]``), ``bounds`` the rows'
+        bounds at the epochs."""
+        x0 = np.asarray(x0, float)
+        seg = self.segment(epochs[0], x0)
+        J = int(np.searchsorted(epochs, seg.b, "right")) - 1
+        ts, n = np.asarray(epochs[:J + 1], float), x0.size
+        loc = slice(bounds[0] - seg.lo, bounds[J] - seg.lo)
+        k_row = np.repeat(np.arange(J), np.diff(bounds[:J + 1]))
+        H = seg.H_lin[loc].copy()
+        computed = seg.value[loc] + H[:, self._lin_idx] @ x0[self._lin_idx]
+        refs, Phi = np.repeat(x0[None], J + 1, 0), np.repeat(np.eye(n)[None], J, 0)
+        for sc, traj in seg.trajs.items():
+            st, p = self._state[sc], seg.pidx[sc]
+            x, Phi_t, Phi_inv, S = traj.at_many(ts)
+            M = Phi_t[1:] @ Phi_inv[:-1]
+            refs[1:, st] = x[1:]
+            Phi[:, st, st] = M
+            Phi[:, st, p] = S[1:] - M @ S[:-1]
+            Hx = np.einsum("ri,rij->rj", seg.G_x[sc][loc], Phi_inv[k_row])
+            H[:, st] = Hx
+            H[:, p] += seg.G_p[sc][loc] - np.einsum("ri,rip->rp", Hx, S[k_row])
+        self._last = (seg, refs[-1])
+        return refs, Phi, computed, H
+
     # -- whole-arc reference --------------------------------------------
     def reference(self, x0) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         """(computed, to_los, status) of every row on the reference from ``x0`` at ``t_start``

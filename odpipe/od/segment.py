@@ -135,6 +135,12 @@ class SegmentTrajectory:
             self.preload([t])
         return self._memo[t]
 
+    def at_many(self, epochs) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+        """:meth:`at` of every epoch, stacked: x (N, 6), Phi (N, 6, 6), Phi^-1 (N, 6, 6), S (N, 6, p)."""
+        self.preload(epochs)
+        got = [self._memo[float(t)] for t in epochs]
+        return tuple(np.array([g[i] for g in got]) for i in range(4))
+
     def preload(self, epochs) -> None:
         """Evaluate (x, Phi, Phi^-1, S) at ``epochs`` inside the segment in one vectorized pass."""
         ts = np.asarray([t for t in np.atleast_1d(epochs) if self.t0 < t <= self.t1 and t not in self._memo], float)
