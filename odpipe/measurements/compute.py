@@ -277,6 +277,14 @@ class Group:
         return solve_path(nodes, t, anchor=anchor, t_corr=c, shapiro_bodies=self.setup.shapiro_bodies,
                           ephemeris=self.setup.ephemeris, origin=self.setup.origin)
 
+    def solve_interval(self, nodes, anchor: str = "receive"):
+        """Count-interval starts and ends (UTC) and the light-time solutions there, each distinct epoch solved
+        once (consecutive counts share their bounds)."""
+        s, e = self.interval()
+        epochs, which = np.unique(np.concatenate([s, e]), return_inverse=True)
+        sol = self.solve(nodes, epochs, anchor)
+        return s, e, sol.take(which[:s.size]), sol.take(which[s.size:])
+
     def interval(self):
         """Start and end (UTC) of each row's count interval."""
         s, e = interval_bounds(self.epoch.astype(np.int64), self.rows["count_time"].to_numpy(float),
@@ -332,14 +340,14 @@ def _dsn_two_way(grp: Group):
                              read), roles
     m2 = g["transponder_ratio"].to_numpy(float)
     m2 = np.where(np.isfinite(m2), m2, turnaround_ratio(g["band_up"].to_numpy(object), g["band_down"].to_numpy(object)))
-    s, e = grp.interval()
+    s, e, sol_s, sol_e = grp.solve_interval(nodes)
     ref = None
     if "odf_data_type" in g.columns and g["ramped"].to_numpy(bool).all():
         ref = g["reference_hz"].to_numpy(float)  # ODF ramped Doppler: M2 f_REF - f_received
     elif grp.obs == "doppler_3way" and setup.ramps is not None and rx in getattr(setup.ramps, "stations", []) \
             and g["ramped"].to_numpy(bool).all():
         ref = setup.ramps
-    return dsn.dsn_doppler(grp.solve(nodes, s), grp.solve(nodes, e), up, tx, s, e, m2, ref, rx), roles
+    return dsn.dsn_doppler(sol_s, sol_e, up, tx, s, e, m2, ref, rx), roles
 
 
 @model("doppler_1way")

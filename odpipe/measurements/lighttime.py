@@ -40,7 +40,7 @@ chained through their shared epochs. The Shapiro term's own derivative
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, fields
 from typing import Sequence
 
 import numba
@@ -125,6 +125,10 @@ class PathSolution:
     def clock_time(self) -> np.ndarray:
         """Total light time counted by the end nodes' clocks (s): TDB interval minus the clock terms."""
         return self.light_time - (self.clock[:, -1] - self.clock[:, 0])
+
+    def take(self, idx) -> "PathSolution":
+        """The solutions of paths ``idx`` (an index array)."""
+        return PathSolution(*(getattr(self, f.name)[idx] for f in fields(self)))
 
 
 def _shifted(t, corr, dt):
