@@ -204,3 +204,26 @@ def test_coarse_references_near_an_integrated_one_are_shifted_not_integrated(cas
     prob.set_coarse(False)
     prob.trajectories(t_man, x)
     assert prob.n_propagations == 3
+
+
+def test_span_answers_every_interval_as_predict_and_transition_do(case):
+    """``span`` (a segment's intervals at once, the fit's sweep) gives the references, transitions and rows of
+    the interval at ``ta`` that ``transition`` and ``predict`` (checked against finite differences above) give,
+    and stops at the segment's end."""
+    sc, reg, prob, ta, x_a, x_man = case["sc"], case["reg"], case["prob"], case["ta"], case["x_a"], case["x_man"]
+    times = case["times"]
+    epochs = np.concatenate([np.arange(sc["t_man"], ta + 3600.0, 1800.0), [ta, ta + 3600.0, sc["t1"] + 3600.0]])
+    epochs = np.unique(epochs)
+    bounds = np.searchsorted(times, epochs, "left")
+    refs, Phi, computed, H = prob.span(epochs, x_man, bounds)
+    assert Phi.shape[0] == epochs.size - 2            # the last epoch lies past the segment's end (the arc end)
+    k = int(np.searchsorted(epochs, ta))
+    np.testing.assert_array_equal(refs[k], x_a)
+    x1, Phi_ta = prob.transition(ta, ta + 3600.0, x_a)
+    np.testing.assert_array_equal(refs[k + 1], x1)
+    assert _normalized_error(Phi[k], Phi_ta) < 1e-14
+    sel = np.arange(bounds[k], bounds[k + 1])
+    c_ta, H_ta = prob.predict(ta, x_a, sel)
+    r = slice(bounds[k] - bounds[0], bounds[k + 1] - bounds[0])
+    assert _normalized_error(computed[r], c_ta) < 1e-14
+    assert _normalized_error(H[r], H_ta) < 1e-12

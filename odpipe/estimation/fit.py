@@ -9,11 +9,19 @@ registry coordinates (the full parameter vector, state and parameters alike):
   ``t0`` is applied at the start of the interval.
 * ``predict(t0, x0, rows) -> (computed, H)``: computed values of observation
   rows (all with ``t0 <= t < t1``) and their partials w.r.t. the vector at ``t0``.
+* optionally ``span(epochs, x0, bounds) -> (refs, Phi, computed, H)``: ``predict`` and ``transition``
+  over the grid intervals from ``epochs[0]`` (reference ``x0``) for as many intervals as the
+  reference holds (J >= 1: references at J + 1 epochs, J transitions, the rows
+  ``bounds[0]:bounds[J]``), answered at once instead of interval by interval;
 * optionally ``set_coarse(on)``: the fit turns it on for the passes of its loose-weight
   stages (all but the last ``sigma_scale``) and for the first pass of the last stage (which
   edits nothing), whose references need not be exact (they only bring the reference near
   the solution), and off for the other passes of the last stage and once the iterations
   end; a fit never ends converged on a coarse pass.
+
+Each pass first flies the reference over the grid (the problem's answers do not depend on the
+filter), then filters each stretch between stochastic steps in one compiled loop
+(:meth:`.srif.SRIF.intervals`).
 
 The grid holds the arc ends, a regular spacing (``block`` s), the batch
 boundaries of every stochastic parameter and any extra epochs (maneuvers). At a
