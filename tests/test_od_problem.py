@@ -212,7 +212,7 @@ def test_span_answers_every_interval_as_predict_and_transition_do(case):
     and stops at the segment's end."""
     sc, reg, prob, ta, x_a, x_man = case["sc"], case["reg"], case["prob"], case["ta"], case["x_a"], case["x_man"]
     times = case["times"]
-    epochs = np.concatenate([np.arange(sc["t_man"], ta + 3600.0, 1800.0), [ta, ta + 3600.0, sc["t1"] + 3600.0]])
+    epochs = np.concatenate([np.arange(sc["t_man"], ta, 1800.0), [ta, ta + 3600.0, sc["t1"] + 3600.0]])
     epochs = np.unique(epochs)
     bounds = np.searchsorted(times, epochs, "left")
     refs, Phi, computed, H = prob.span(epochs, x_man, bounds)
