@@ -144,9 +144,9 @@ def long_arc():
     calls = []                                  # (days, iterations, s) of each fit inside fit_arc
     fit = arc_module.fit
 
-    def timed_fit(problem, obs, t_start, t_end, options, x_ref=None):
+    def timed_fit(problem, obs, t_start, t_end, options, **kw):
         s = time.perf_counter()
-        sol = fit(problem, obs, t_start, t_end, options, x_ref=x_ref)
+        sol = fit(problem, obs, t_start, t_end, options, **kw)
         calls.append(((t_end - t_start) / 86400.0, len(sol.history), time.perf_counter() - s))
         return sol
 
