@@ -29,6 +29,13 @@ ONEWAY = {"data.observables": '["doppler_2way", "doppler_1way:X"]',
           "estimation.data_sigma": "{ doppler_2way = 0.002, doppler_1way = 0.002 }",
           "estimation.oscillator_sigma": "[1e-6, 1e-12]"}
 LOCK = {"preprocess.lock_transient_k": "10.0"}
+# the S-band one-way too, its transponder oscillator re-estimated every pass (an offset and a drift per 5-min
+# acquisition series, benchmarks/grail_sband.py), X keeping its own; passes of 4 rows kept (the series are 4-6
+# 60-s windows long, every one shorter than the nightly's 10)
+SBAND = {"data.observables": '["doppler_2way", "doppler_1way:X", "doppler_1way:S"]',
+         "estimation.oscillator_sigma": "{ X = [1e-6, 1e-12], S = [1e-5, 1e-10] }",
+         "estimation.oscillator_per": '{ S = "pass" }',
+         "preprocess.min_pass_samples": "4"}
 # name -> {"section.key": TOML literal}; "base" is the nightly configs as they are (since issue #24's rule:
 # stochastic sigma 3e-7 m/s^2 and preprocess.apriori_blunder_k 10; docs/validation.md names the earlier runs).
 # The figures of docs/validation.md's lock-transient section were run at commit aaf3957, whose nightly was two-way
@@ -50,6 +57,10 @@ CANDIDATES = {
     # with the one-way X band
     "lock": LOCK,
     "oneway_lock": {**ONEWAY, **LOCK},
+    # on top of the nightly (oneway_lock): the S-band one-way with its own per-pass oscillator; "minpass4" the
+    # nightly with only the shorter passes kept (what else "sband" changes)
+    "sband": SBAND,
+    "minpass4": {"preprocess.min_pass_samples": "4"},
 }
 
 # Two-day arcs (runs/grail_b_2day_*.toml) as candidates: name -> the daily candidate whose settings they take and
