@@ -30,9 +30,11 @@ ONEWAY = {"data.observables": '["doppler_2way", "doppler_1way:X"]',
           "estimation.oscillator_sigma": "[1e-6, 1e-12]"}
 LOCK = {"preprocess.lock_transient_k": "10.0"}
 # the S-band one-way too, its transponder oscillator re-estimated every pass (an offset and a drift per 5-min
-# acquisition series, benchmarks/grail_sband.py), X keeping its own; passes of 4 rows kept (the series are 4-6
-# 60-s windows long, every one shorter than the nightly's 10)
+# acquisition series, benchmarks/grail_sband.py), X keeping its own; weighted at 5 cm/s (what a line leaves of
+# the oscillator's warm-up over a series, orbit-free, tests/test_grail_sband.py); passes of 4 rows kept (the
+# series are 4-6 60-s windows long, every one shorter than the nightly's 10)
 SBAND = {"data.observables": '["doppler_2way", "doppler_1way:X", "doppler_1way:S"]',
+         "estimation.data_sigma": '{ doppler_2way = 0.002, doppler_1way = 0.002, "doppler_1way:S" = 0.05 }',
          "estimation.oscillator_sigma": "{ X = [1e-6, 1e-12], S = [1e-5, 1e-10] }",
          "estimation.oscillator_per": '{ S = "pass" }',
          "preprocess.min_pass_samples": "4"}
