@@ -12,6 +12,7 @@ from dataclasses import replace
 
 import numpy as np
 
+from odpipe.estimation.fit import FitDiverged
 from odpipe.od import ArcSetup, fit_arc
 from odpipe.simulate.observe import simulate_tracking
 from test_od_simulate import arc_state, force_model, measurement_setup, scenario
@@ -88,17 +89,18 @@ def _two_oscillator_case():
     return sc, table, truth
 
 
-def _oscillator_fit(sc, table, sigma, per):
+def _oscillator_fit(sc, table, sigma, per, **kw):
     setup = ArcSetup("SC", sc["t0"], sc["t1"], arc_state(sc), force_model(), measurement_setup(),
                      data_sigma={"range": 1.0, "doppler_1way": 1e-4}, range_bias_sigma=None,
-                     oscillator_sigma=sigma, oscillator_per=per)
+                     oscillator_sigma=sigma, oscillator_per=per, **kw)
     return fit_arc(table, setup)
 
 
 def test_x_and_per_pass_s_oscillators_recovered_within_chi2_bounds():
     """Each band its own oscillator, S re-estimated every pass: every y0 and y1 (X's and each S pass's, about its
     pass's mid-time) within the union chi-square bound of its sigma, and the post-fit RMS within its chi-square
-    bounds; fitted as one oscillator serving both bands, the same data leave a post-fit RMS far above the bound."""
+    bounds; fitted as one oscillator serving both bands, the same data leave a post-fit RMS far above the bound
+    (or the fit diverges)."""
     sc, table, truth = _two_oscillator_case()
     sol = _oscillator_fit(sc, table, {"X": (1.0 / F0, 1e-5 / F0), "S": (1e-5, 1e-10)}, {"S": "pass"})
     lo, hi = rms_bounds(int((sol.residuals["flags"] == 0).sum()), len(sol.parameters))
@@ -112,5 +114,8 @@ def test_x_and_per_pass_s_oscillators_recovered_within_chi2_bounds():
         for term, true in (("y0", y0 + y1 * (fit_ref[f"{name}.osc_y0"] - t_ref)), ("y1", y1)):
             est, sig = osc.loc[f"{name}.osc_{term}", ["estimate", "sigma"]]
             assert abs(est - true) < bound * sig, (name, term, est, true, sig)
-    one = _oscillator_fit(sc, table, (1e-5, 1e-10), {})
-    assert one.history[-1]["postfit_rms"] > 100 * hi
+    try:
+        one = _oscillator_fit(sc, table, (1e-5, 1e-10), {}, max_iter=3).history[-1]["postfit_rms"]
+    except FitDiverged:
+        one = np.inf
+    assert one > 100 * hi
