@@ -6,18 +6,28 @@ downlink reference f is then the oscillator's fractional offset ``y = -r / f`` p
 uncalibrated media and the 1-s noise (together ~1e-11). Printed per band, station and series of samples (a gap over ``--gap`` s starts a new series): the mean
 y, its spread, and its slope; beside it the arc's fitted X-band oscillator (parameters.csv).
 
+``--acquisition-only``: the leave-one-out candidate "sband" run again (into ``OUT/sband_acq``, the nightly chain)
+with the S-band one-way series that begin within ``--after-two-way`` s of the end of a two-way series of the
+spacecraft removed at ingest: the transponder coasting from its last uplink-locked frequency, which no offset and
+drift follow (m/s off a line), leaving the acquisition series before each two-way lock. A what-if for judging
+what the S band can give, not a pipeline rule.
+
     nice .venv/bin/python benchmarks/grail_sband.py [--runs out] [--arcs 04_10 ...]
+    nice .venv/bin/python benchmarks/grail_sband.py --acquisition-only [--out out/grail_loo]
 """
 
 from __future__ import annotations
 
 import argparse
+from dataclasses import replace
 from pathlib import Path
 
 import numpy as np
 import pandas as pd
 
-from grail_arcs import DAILY, RUNS
+import odpipe.pipeline.run as pipeline_run
+from grail_arcs import DAILY, RUNS, run_start, run_variant
+from grail_loo import CANDIDATES
 from odpipe.analysis.overlap import oem_trajectory
 from odpipe.frames.earth import gcrs_to_itrs
 from odpipe.measurements import MeasurementSetup, compute
@@ -72,14 +82,52 @@ def oscillator_table(name: str, runs: Path, gap_s: float, every: int) -> pd.Data
     return pd.DataFrame(out)
 
 
+def after_two_way(table: pd.DataFrame, within_s: float, gap_s: float = 600.0) -> np.ndarray:
+    """True for the S-band one-way rows of series (``gap_s``) that begin within ``within_s`` s after the end of a
+    two-way Doppler series (any station) of the same spacecraft."""
+    t = table["epoch"].to_numpy("datetime64[ns]").astype(np.int64) / 1e9
+    two = np.sort(t[(table["observable"] == "doppler_2way").to_numpy()])
+    ends = two[np.r_[np.diff(two) > gap_s, True]] if two.size else two
+    one = ((table["observable"] == "doppler_1way") & (table["band_down"].astype(str) == "S")).to_numpy()
+    out = np.zeros(len(table), bool)
+    idx = np.flatnonzero(one)
+    if idx.size == 0 or ends.size == 0:
+        return out
+    rows = table.iloc[idx].assign(_t=t[idx], _i=idx).sort_values(["station_rx", "_t"])
+    first = rows["_t"].groupby(series(rows.rename(columns={"_t": "t"}), gap_s)).transform("min").to_numpy()
+    k = np.searchsorted(ends, first, side="right") - 1
+    since = np.where(k >= 0, first - ends[np.maximum(k, 0)], np.inf)
+    out[rows["_i"].to_numpy()] = since <= within_s
+    return out
+
+
+def _acquisition_only(within_s: float):
+    """An ingest without the S-band one-way series that begin within ``within_s`` s after a two-way series ends."""
+    def read(files, errors, *spacecraft):
+        data = ingest(files, errors, *spacecraft)
+        return replace(data, table=data.table[~after_two_way(data.table, within_s)].reset_index(drop=True))
+    return read
+
+
 def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--runs", type=Path, default=RUNS / "out", help="folder of the arcs' run folders")
     ap.add_argument("--arcs", nargs="*", default=DAILY)
     ap.add_argument("--gap", type=float, default=600.0, help="s: a longer gap starts a new series")
     ap.add_argument("--every", type=int, default=10, help="every n-th raw sample")
+    ap.add_argument("--acquisition-only", action="store_true", help="run the what-if chain (see above)")
+    ap.add_argument("--after-two-way", type=float, default=300.0, help="s: coasting series begin within this")
+    ap.add_argument("--out", type=Path, default=Path("out/grail_loo"), help="the leave-one-out folder")
     args = ap.parse_args()
     pd.set_option("display.width", 200)
+    if args.acquisition_only:
+        out = args.out.resolve()
+        saved, pipeline_run.ingest = pipeline_run.ingest, _acquisition_only(args.after_two_way)
+        try:
+            print(run_variant(out / "sband_acq", CANDIDATES["sband"], run_start(out / "start")))
+        finally:
+            pipeline_run.ingest = saved
+        return
     for name in args.arcs:
         tab = oscillator_table(name, args.runs, args.gap, args.every)
         params = pd.read_csv(args.runs / name / "current" / "parameters.csv").set_index("name")
