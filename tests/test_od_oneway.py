@@ -119,3 +119,16 @@ def test_x_and_per_pass_s_oscillators_recovered_within_chi2_bounds():
     except FitDiverged:
         one = np.inf
     assert one > 100 * hi
+
+
+def test_a_row_counts_against_the_most_specific_oscillator_known():
+    """Pass over band over spacecraft; unknown names fall back; rows without pass ids take the band's."""
+    import pandas as pd
+
+    from odpipe.measurements import oscillators
+
+    rows = pd.DataFrame({"band_down": ["S", "S", "x", "Ka"], "pass_id": [4, 5, 4, 4]})
+    known = {"SC": (0, 0, 0), "SC:S:pass4": (0, 0, 0), "SC:X": (0, 0, 0)}
+    assert list(oscillators.row_names("SC", rows, known)) == ["SC:S:pass4", "SC", "SC:X", "SC"]
+    assert list(oscillators.row_names("SC", rows.drop(columns="pass_id"), known)) == ["SC", "SC", "SC:X", "SC"]
+    assert oscillators.name("SC", "ka", 3) == "SC:Ka:pass3"
