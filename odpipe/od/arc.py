@@ -234,11 +234,12 @@ def oscillator_terms(setup: ArcSetup, rows: pd.DataFrame) -> list[tuple[str, tup
         return [(sc, known.get(sc, (0.0, 0.0, setup.start)), tuple(setup.oscillator_sigma))]
     out = []
     bands = one_way["band_down"].map(band_name)
+    per = {band_name(b): v for b, v in setup.oscillator_per.items()}
     for band, sigmas in setup.oscillator_sigma.items():
         mine = one_way[(bands == band_name(band)).to_numpy()]
         if mine.empty:
             continue
-        if setup.oscillator_per.get(band, "arc") == "pass":
+        if per.get(band_name(band), "arc") == "pass":
             for pid, g in mine.groupby("pass_id", sort=True):
                 out.append((oscillators.name(sc, band, pid), (0.0, 0.0, float(reception_times(g).mean())),
                             tuple(sigmas)))
