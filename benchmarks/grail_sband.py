@@ -3,8 +3,9 @@
 Each daily arc's raw one-way samples (both bands, every ``--every``-th, inside the arc) are computed along the
 arc's fitted orbit (its ``trajectory.oem``) with a nominal oscillator (y0 = y1 = 0). A one-way residual r (Hz) at
 downlink reference f is then the oscillator's fractional offset ``y = -r / f`` plus the orbit's error, the
-uncalibrated media and the 1-s noise (together ~1e-11). Printed per band, station and series of samples (a gap over ``--gap`` s starts a new series): the mean
-y, its spread, and its slope; beside it the arc's fitted X-band oscillator (parameters.csv).
+uncalibrated media and the 1-s noise (together ~1e-11). Printed per band, station and series of samples (a gap
+over ``--gap`` s starts a new series): the mean y, its RMS about a line and the line's slope (1/s); beside them
+the arc's fitted X-band oscillator (its parameters.csv).
 
 ``--acquisition-only``: the leave-one-out candidate "sband" run again (into ``OUT/sband_acq``, the nightly chain)
 with the S-band one-way series that begin within ``--after-two-way`` s of the end of a two-way series of the
@@ -12,7 +13,7 @@ spacecraft removed at ingest: the transponder coasting from its last uplink-lock
 drift follow (m/s off a line), leaving the acquisition series before each two-way lock. A what-if for judging
 what the S band can give, not a pipeline rule.
 
-    nice .venv/bin/python benchmarks/grail_sband.py [--runs out] [--arcs 04_10 ...]
+    nice .venv/bin/python benchmarks/grail_sband.py [--runs runs/out] [--arcs grail_b_2012_04_10 ...] [--every 10]
     nice .venv/bin/python benchmarks/grail_sband.py --acquisition-only [--out out/grail_loo]
 """
 
@@ -47,7 +48,8 @@ def series(rows: pd.DataFrame, gap_s: float) -> np.ndarray:
 
 
 def one_way_rows(name: str, every: int) -> pd.DataFrame:
-    """Arc ``name``'s raw one-way samples of its spacecraft inside the arc (10 s from its ends), every ``every``-th per station and band."""
+    """Arc ``name``'s raw one-way samples of its spacecraft inside the arc (10 s from its ends), every
+    ``every``-th per station and band."""
     cfg = load_config(RUNS / f"{name}.toml")
     table = ingest(cfg.data.files, cfg.data.errors, cfg.arc.spacecraft).table
     epoch = table["epoch"].to_numpy("datetime64[ns]")
