@@ -40,7 +40,8 @@ rows that do not involve the group):
 ``state:<sc>`` (6, d/d epoch state of the trajectory), ``dynamic:<sc>``
 (p, ``traj.param_names``), ``station:<name>`` (3, ITRS m), ``bias`` (1, unit of
 the row), ``delay`` (1, per s of range delay), ``media_scale`` (1),
-``oscillator:<name>`` (2: fractional offset y0, drift y1 1/s; names of :mod:`.oscillators`), ``clock:<sc>`` (3: c*a0, c*a1, c*a2).
+``oscillator:<name>`` (2: fractional offset y0, drift y1 1/s; names of :mod:`.oscillators`),
+``clock:<sc>`` (3: c*a0, c*a1, c*a2).
 Trajectories without ``stm`` (reference ephemerides) give values but no state groups.
 Rows that cannot be computed get NaN and a reason in :attr:`Evaluation.status`.
 """
