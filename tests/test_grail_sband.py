@@ -3,8 +3,9 @@
 The X-band one-way is the beacon driven by the ultra-stable oscillator; the S-band one-way (5-minute series at
 each acquisition, before the two-way lock) comes from the transponder. Where both bands are received at one
 station at the same second, the ratio of their received frequencies, each over its reference, is
-``(1 + y_S) / (1 + y_X)`` whatever the orbit (the Doppler shift is one fraction for both bands; the ionosphere's
-difference is below 1e-12 here): the oscillators' offset, orbit-free. Against the fitted orbit
+``(1 + y_S) / (1 + y_X)`` whatever the orbit (the Doppler shift is one fraction for both bands; only the
+ionosphere's dispersive rate differs, and the ratio leaves 8e-12 about a parabola): the oscillators' offset,
+orbit-free. Against the fitted orbit
 (benchmarks/grail_sband.py, docs/validation.md) the 2012-04-10 DSS-34 5-min series gave y_S = 1.395e-6 and
 1.352e-6 and the arc's X oscillator y_X = 1.510e-8: the ratio must give their differences, and show the offset
 re-set between the series of one station by more than any single y0 and y1 over the arc could follow.
