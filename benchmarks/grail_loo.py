@@ -59,11 +59,12 @@ CANDIDATES = {
     # with the one-way X band
     "lock": LOCK,
     "oneway_lock": {**ONEWAY, **LOCK},
-    # on top of the nightly (oneway_lock): the S-band one-way with its own per-pass oscillator; "minpass4" the
-    # nightly with only the shorter passes kept (what else "sband" changes)
+    # on top of the nightly (oneway_lock): the S-band one-way with its own per-pass oscillator
     "sband": SBAND,
-    "minpass4": {"preprocess.min_pass_samples": "4"},
 }
+# Controls: run and tabulated beside the candidates, never chosen by the rule (a control separates one candidate's
+# effects; it is not a setting proposed for the nightly). "minpass4": the nightly with only sband's shorter passes.
+CONTROLS = {"minpass4": {"preprocess.min_pass_samples": "4"}}
 
 # Two-day arcs (runs/grail_b_2day_*.toml) as candidates: name -> the daily candidate whose settings they take and
 # whose daily arcs they are compared with.
@@ -143,7 +144,8 @@ def main(argv=None):
     ap.add_argument("--source-from", default="", help="candidate whose source-arc runs give the a priori")
     args = ap.parse_args(argv)
     out = args.out.resolve()
-    names = [n for n in [*CANDIDATES, *TWO_DAY_CANDIDATES] if not args.only or n in args.only.split(",")]
+    variants = {**CANDIDATES, **CONTROLS}
+    names = [n for n in [*variants, *TWO_DAY_CANDIDATES] if not args.only or n in args.only.split(",")]
     t0 = time.perf_counter()
     run_start(out / "start")
     print(f"start-up fit ready ({time.perf_counter() - t0:.0f} s)", flush=True)
@@ -159,13 +161,13 @@ def main(argv=None):
                 if not link.exists():
                     link.parent.mkdir(parents=True, exist_ok=True)
                     link.symlink_to(out / args.source_from / a)
-        run_variant(out / cand, CANDIDATES[cand], out / "start", arcs=chosen, log=log)
-        arcs, overlaps = collect(out, CANDIDATES)
+        run_variant(out / cand, variants[cand], out / "start", arcs=chosen, log=log)
+        arcs, overlaps = collect(out, variants)
         arcs.to_csv(out / "arcs.csv", index=False)
         overlaps.to_csv(out / "overlaps.csv", index=False)
-    arcs, overlaps = collect(out, CANDIDATES)
+    arcs, overlaps = collect(out, variants)
     complete = arcs.groupby("candidate")["arc"].nunique()   # a candidate with a failed arc is left out
-    full = complete[complete == len(DAILY)].index
+    full = complete[(complete == len(DAILY)) & ~complete.index.isin(list(CONTROLS))].index
     table = held_out(arcs[arcs["candidate"].isin(full)], overlaps[overlaps["candidate"].isin(full)])
     table.to_csv(out / "held_out.csv", index=False)
     with pd.option_context("display.width", 250, "display.max_columns", 40):
