@@ -105,13 +105,17 @@ def run_start(out: Path) -> Path:
 
 def arc_figures(out: Path, name: str) -> dict:
     """Post-fit RMS per station (mm/s), rows fitted and edited by the fit, of one arc's current run: two-way
-    Doppler (``rms_mm_s.<station>``, ``fitted``, ``edited``) and, when fitted, one-way (``rms1w_mm_s.<station>``,
-    ``fitted_1way``, ``edited_1way``)."""
+    Doppler (``rms_mm_s.<station>``, ``fitted``, ``edited``) and, when fitted, one-way X band
+    (``rms1w_mm_s.<station>``, ``fitted_1way``, ``edited_1way``) and S band (``rms1wS_mm_s.<station>``,
+    ``fitted_1wayS``, ``edited_1wayS``)."""
     run = out / name / "current"
     res = pd.read_parquet(run / "residuals.parquet")
+    band = pd.read_parquet(run / "tracking.parquet", columns=["band_down"])["band_down"].to_numpy()[res["row"]]
     row = {"arc": name}
-    for obs, suffix, key in (("doppler_2way", "", "rms_mm_s"), ("doppler_1way", "_1way", "rms1w_mm_s")):
-        ok = (res["status"] == "") & (res["observable"] == obs)
+    for obs, suffix, key, bands in (("doppler_2way", "", "rms_mm_s", ("S", "X")),
+                                    ("doppler_1way", "_1way", "rms1w_mm_s", ("X",)),
+                                    ("doppler_1way", "_1wayS", "rms1wS_mm_s", ("S",))):
+        ok = (res["status"] == "") & (res["observable"] == obs) & np.isin(band, bands)
         if obs == "doppler_1way" and not ok.any():
             continue
         row[f"fitted{suffix}"] = int((ok & (res["flags"] == 0)).sum())

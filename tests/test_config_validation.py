@@ -78,6 +78,10 @@ def test_the_good_configuration_loads(tmp_path):
     ("state = [7.0e6, 0.0, 0.0, 0.0, 7.5e3, 0.0]", "state = [7.0e6, 0.0, 0.0, 0.0, 7.5e3, inf]",
      "initial_state.state", "needs 6 finite numbers (m, m/s)"),
     ('center = "earth"', 'center = "earth"\nmas = 5.0', "dynamics.mas", "unknown key (allowed: center, drag, ephemeris"),
+    ("sigma_position = 1000.0", "sigma_position = 1000.0\noscillator_sigma = { X = [1e-6, 1e-12], Q = [1e-5, 1e-10] }",
+     "estimation.oscillator_sigma.Q", "'Q' is not a band (S, X, Ka)"),
+    ("sigma_position = 1000.0", "sigma_position = 1000.0\noscillator_sigma = [1e-6]", "estimation.oscillator_sigma",
+     "[1e-06] must be two sigmas: [y0, y1 (1/s)]"),
 ])
 def test_one_bad_value_names_its_key_and_line(tmp_path, capsys, old, new, key, reason):
     text = GOOD.replace(old, new)

@@ -17,8 +17,9 @@ doppler_2way/3way  count-averaged Doppler (Hz), interval from ``epoch``/``tag``/
                    use the record's ``reference_hz`` (constant); other ramped three-way rows the
                    receiver's own ramp when the store has it; else the transmitter's uplink.
 doppler_1way       f_ref = ``uplink_hz`` (ODF rows: times 880/240 for X, 3344/240 for Ka downlinks, as
-                   the ODF gives it at S-band scale); the oscillator from ``setup.oscillators``
-                   (default: nominal f_ref, no bias or drift).
+                   the ODF gives it at S-band scale, row by row); each row's oscillator from
+                   ``setup.oscillators`` by :func:`.oscillators.row_names` (spacecraft, band, pass;
+                   default: nominal f_ref, no bias or drift).
 angle_az/el/x/y    antenna angles at reception (rad); elevations apparent with ``setup.elevation_refraction``.
 range_rate         instantaneous station-spacecraft range-rate at reception (m/s), for studies.
 sst_range          crosslink two-way range (m); ``spacecraft`` = sc1 (transmits and receives,
@@ -39,7 +40,8 @@ rows that do not involve the group):
 ``state:<sc>`` (6, d/d epoch state of the trajectory), ``dynamic:<sc>``
 (p, ``traj.param_names``), ``station:<name>`` (3, ITRS m), ``bias`` (1, unit of
 the row), ``delay`` (1, per s of range delay), ``media_scale`` (1),
-``oscillator:<sc>`` (2: fractional offset y0, drift y1 1/s), ``clock:<sc>`` (3: c*a0, c*a1, c*a2).
+``oscillator:<name>`` (2: fractional offset y0, drift y1 1/s; names of :mod:`.oscillators`),
+``clock:<sc>`` (3: c*a0, c*a1, c*a2).
 Trajectories without ``stm`` (reference ephemerides) give values but no state groups.
 Rows that cannot be computed get NaN and a reason in :attr:`Evaluation.status`.
 """
@@ -57,7 +59,7 @@ from odpipe.environment.ephemeris import SpanEphemeris
 from odpipe.frames.tabulated import TabulatedRotation
 from odpipe.tracking.timetags import interval_bounds
 
-from . import angles, crosslink, dsn, instantaneous, refraction
+from . import angles, crosslink, dsn, instantaneous, oscillators, refraction
 from .bands import ONE_WAY_SCALE, band_name, range_unit_factor, turnaround_ratio
 from .computed import Computed, ConstantUplink
 from .lighttime import anchor_from_utc, solve_path
@@ -71,8 +73,9 @@ _ANGLES = {"angle_az": "azimuth", "angle_el": "elevation", "angle_x": "x", "angl
 class MeasurementSetup:
     """Everything the models need besides rows and trajectories; built once per run.
 
-    oscillators: spacecraft -> (y0, y1 1/s, t_ref TDB s) of its one-way oscillator: fractional frequency
-    offset from each row's reference frequency and its drift (:func:`.dsn.one_way_doppler`).
+    oscillators: oscillator name (:mod:`.oscillators`: a spacecraft, one band of it, one pass of that band) ->
+    (y0, y1 1/s, t_ref TDB s): fractional frequency offset from each one-way row's reference frequency and its
+    drift (:func:`.dsn.one_way_doppler`).
     clocks: spacecraft -> :class:`.crosslink.ClockModel` for dual one-way ranging.
     com_offsets: spacecraft -> centre-of-mass offset (m) of its ranging reflector or antenna towards the
     stations (LAGEOS: 0.251 m): each leg of a ``range`` row is that much shorter than to the centre of mass.
@@ -358,14 +361,18 @@ def _one_way_doppler(grp: Group):
     nodes = [setup.spacecraft(traj, sc), st_rx]
     f_ref = g["uplink_hz"].to_numpy(float)
     if "odf_data_type" in g.columns:  # ODF gives the one-way reference at S-band scale (parsers.odf)
-        f_ref = f_ref * ONE_WAY_SCALE.get(band_name(g["band_down"].iloc[0]), np.nan)
-    y0, y1, t_ref = setup.oscillators.get(sc, (0.0, 0.0, 0.0))
+        f_ref = f_ref * g["band_down"].map(lambda b: ONE_WAY_SCALE.get(band_name(b), np.nan)).to_numpy(float)
+    names = oscillators.row_names(sc, g, setup.oscillators)
+    known, which = np.unique(names.astype(str), return_inverse=True)
+    y0, y1, t_ref = np.array([setup.oscillators.get(k, (0.0, 0.0, 0.0)) for k in known], float)[which.ravel()].T
     s, e = grp.interval()
     sols = grp.solve(nodes, s), grp.solve(nodes, e)
     proper = 0.5 * sum(proper_rate_offset(setup.ephemeris, setup.origin, p.epochs[:, 0] + p.epoch_corr[:, 0],
                                           p.states[:, 0]) for p in sols)
     comp = dsn.one_way_doppler(*sols, f_ref, g["count_time"].to_numpy(float), y0, y1, t_ref, proper)
-    comp.params[f"oscillator:{sc}"] = np.stack([comp.params.pop("osc_y0"), comp.params.pop("osc_y1")], 1)
+    d = np.stack([comp.params.pop("osc_y0"), comp.params.pop("osc_y1")], 1)
+    for k in dict.fromkeys(names):   # one partial group per oscillator, zero on the other rows
+        comp.params[f"oscillator:{k}"] = d * (names == k)[:, None]
     return comp, _receiver(grp, st_rx, traj)
 
 

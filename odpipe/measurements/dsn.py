@@ -114,7 +114,8 @@ def one_way_doppler(sol_s, sol_e, f_ref, count_time, y0=0.0, y1=0.0, t_ref=0.0, 
 
     ``f_ref``: the station's reference, the transmitted frequency it expects (Hz). The spacecraft
     oscillator transmits ``f_ref (1 + y0 + y1 (t2 - t_ref))``: ``y0`` fractional frequency offset,
-    ``y1`` its drift (1/s) about ``t_ref`` (TDB s), so one oscillator serves every band it drives.
+    ``y1`` its drift (1/s) about ``t_ref`` (TDB s), scalars or one per row (each row its oscillator,
+    :mod:`.oscillators`); as fractions, one oscillator serves every band it drives.
     That frequency is in the spacecraft's proper time; ``proper`` (N,) is 1 - dτ/dt over the count
     (:func:`.nodes.proper_rate_offset`), which lowers it in TDB (±175 mm/s at X band about the Moon).
     Parameters: 'osc_y0', 'osc_y1' (the estimable oscillator terms), 'bias' (Hz).

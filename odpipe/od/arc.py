@@ -26,7 +26,8 @@ from odpipe.dynamics.polynomial import PARAMETERS as POLY_PARAMETERS
 from odpipe.estimation.fit import EDIT_INNOVATION, NONFINITE, FitOptions, Observations, Solution, build_grid, fit
 from odpipe.estimation.maneuvers import maneuver_table
 from odpipe.estimation.registry import GaussMarkov, ParameterRegistry
-from odpipe.measurements import MeasurementSetup
+from odpipe.measurements import MeasurementSetup, oscillators
+from odpipe.measurements.bands import band_name
 from odpipe.measurements.compute import spanning
 from odpipe.od.outward import labelled
 from odpipe.preprocess.flags import Flag
@@ -80,7 +81,9 @@ class ArcSetup:
     station with the most rows, whose own is zero: an offset common to every station moves the whole data set
     in time, which the epoch state absorbs (the orbit flown that much earlier).
     oscillator_sigma: (y0, y1 1/s) sigmas of the one-way oscillator's fractional frequency offset and drift,
-    when doppler_1way is fitted (a priori and reference epoch from ``measurements.oscillators``).
+    when doppler_1way is fitted (a priori and reference epoch from ``measurements.oscillators``): one pair for
+    every band, or {band: pair} for one oscillator per band named; oscillator_per: {band: "arc" | "pass"}, "pass"
+    for an oscillator re-estimated every pass of that band (:func:`oscillator_terms`).
     station_sigma: considered (not estimated) error of each station's ITRS coordinates (m per axis).
     station_position_sigma: {station: m per ITRS axis}: those stations' coordinate offsets estimated (a priori 0).
     media_sigma: considered error of the media calibration scale (fraction of ``media_m``).
@@ -117,7 +120,8 @@ class ArcSetup:
     bias_apriori: dict = field(default_factory=dict)
     cd_sigma: float | None = None
     polynomial_sigma: tuple | None = None
-    oscillator_sigma: tuple | None = None
+    oscillator_sigma: tuple | dict | None = None
+    oscillator_per: dict = field(default_factory=dict)
     station_sigma: float | None = None
     station_position_sigma: dict = field(default_factory=dict)
     media_sigma: float | None = None
@@ -183,7 +187,7 @@ def sigma_value(key: str, value) -> float:
 
 def data_sigma(rows: pd.DataFrame, sigmas: dict) -> np.ndarray:
     """Per-row sigma (m or m/s; rad for angle rows): the "observable:station_rx" entry if there is one, else
-    the observable's."""
+    the "observable:band_down" one (e.g. "doppler_1way:S"), else the observable's."""
     values = {}
     for k, v in sigmas.items():
         try:
@@ -191,6 +195,8 @@ def data_sigma(rows: pd.DataFrame, sigmas: dict) -> np.ndarray:
         except ValueError as exc:
             raise ValueError(f"data_sigma.{k}: {exc}") from None
     by_station = (rows["observable"] + ":" + rows["station_rx"].astype(str)).map(values)
+    if "band_down" in rows.columns:
+        by_station = by_station.fillna((rows["observable"] + ":" + rows["band_down"].astype(str)).map(values))
     return by_station.fillna(rows["observable"].map(values)).to_numpy(float)
 
 
@@ -210,6 +216,37 @@ def select_rows(table: pd.DataFrame, setup: ArcSetup) -> tuple[pd.DataFrame, np.
     inside = (t >= setup.start) & (t <= setup.end)
     order = np.argsort(t[inside], kind="stable")
     return rows[inside].iloc[order], t[inside][order]
+
+
+def oscillator_terms(setup: ArcSetup, rows: pd.DataFrame) -> list[tuple[str, tuple, tuple]]:
+    """The estimated one-way oscillators of the fitted ``rows``: (name, a priori (y0, y1, t_ref TDB s), sigmas).
+
+    ``oscillator_sigma`` a pair: one oscillator for every band; a table: one per band it names (bands it does
+    not name are not estimated). A band whose ``oscillator_per`` is "pass" gets one oscillator per pass of its
+    rows, about the pass's mean reception time, a priori 0; the others take the a priori of
+    ``measurements.oscillators`` (default 0 about the arc start).
+    """
+    one_way = rows[rows["observable"] == "doppler_1way"]
+    if setup.oscillator_sigma is None or one_way.empty:
+        return []
+    sc, known = setup.spacecraft, setup.measurements.oscillators
+    if not isinstance(setup.oscillator_sigma, dict):
+        return [(sc, known.get(sc, (0.0, 0.0, setup.start)), tuple(setup.oscillator_sigma))]
+    out = []
+    bands = one_way["band_down"].map(band_name)
+    per = {band_name(b): v for b, v in setup.oscillator_per.items()}
+    for band, sigmas in setup.oscillator_sigma.items():
+        mine = one_way[(bands == band_name(band)).to_numpy()]
+        if mine.empty:
+            continue
+        if per.get(band_name(band), "arc") == "pass":
+            for pid, g in mine.groupby("pass_id", sort=True):
+                out.append((oscillators.name(sc, band, pid), (0.0, 0.0, float(reception_times(g).mean())),
+                            tuple(sigmas)))
+        else:
+            osc = oscillators.name(sc, band)
+            out.append((osc, known.get(osc, (0.0, 0.0, setup.start)), tuple(sigmas)))
+    return out
 
 
 def build_registry(setup: ArcSetup, rows: pd.DataFrame) -> ParameterRegistry:
@@ -262,10 +299,9 @@ def build_registry(setup: ArcSetup, rows: pd.DataFrame) -> ParameterRegistry:
         for obs, st in ang[["observable", "station_rx"]].drop_duplicates().itertuples(index=False):
             reg.add(f"bias.{obs}.{st}", "bias", _bias_apriori(setup, obs, st), setup.angle_bias_sigma, owner=st,
                     observable=obs, station=st, spacecraft=sc)
-    if setup.oscillator_sigma is not None and (rows["observable"] == "doppler_1way").any():
-        y0, y1, _ = setup.measurements.oscillators[sc]
-        reg.add(f"{sc}.osc_y0", "clock", y0, setup.oscillator_sigma[0], owner=sc, oscillator="y0")
-        reg.add(f"{sc}.osc_y1", "clock", y1, setup.oscillator_sigma[1], owner=sc, oscillator="y1")
+    for osc, (y0, y1, t_ref), sigmas in oscillator_terms(setup, rows):
+        reg.add(f"{osc}.osc_y0", "clock", y0, sigmas[0], owner=osc, oscillator="y0", t_ref=t_ref)
+        reg.add(f"{osc}.osc_y1", "clock", y1, sigmas[1], owner=osc, oscillator="y1", t_ref=t_ref)
     tx = rows["station_tx"] if "station_tx" in rows else ()
     tracking = (set(rows["station_rx"]) | set(tx)) - {""}
     for st in sorted(tracking & set(setup.station_position_sigma)):

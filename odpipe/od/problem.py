@@ -13,8 +13,10 @@ maneuver        impulsive ICRF dV (``registry.add_maneuver``; owner ``<sc>.<labe
 maneuver_epoch  offset (s) of that maneuver's firing from its logged epoch (``add_maneuver(sigma_epoch=)``);
                 the segment still starts at the logged epoch; reference exact, partials first
                 order in the offset (:mod:`.segment`)
-clock           one-way oscillator: ``info['oscillator']`` 'y0' (fractional frequency offset) or 'y1'
-                (its drift, 1/s); the reference epoch from ``setup.oscillators[sc]``
+clock           one-way oscillator ``owner`` (a name of :mod:`odpipe.measurements.oscillators`: the spacecraft,
+                one band of it or one pass of that band): ``info['oscillator']`` 'y0' (fractional frequency
+                offset) or 'y1' (its drift, 1/s); the reference epoch ``info['t_ref']`` (TDB s), else from
+                ``setup.oscillators[owner]``
 bias            measurement bias along the line of sight (m for range, m/s for Doppler; an angle in rad for
                 angle rows, unit 'rad') of the rows matching ``info`` keys ``observable``, ``station``
                 (receiver), ``pass_id``, ``spacecraft``
@@ -159,8 +161,6 @@ class TrackingProblem:
             raise ValueError(f"{sc}: every maneuver needs dv_x, dv_y, dv_z (an epoch offset alone is not a maneuver)")
         out["maneuvers"] = {t: [d[a] for a in "xyz"] for t, d in man.items()}
         out["maneuver_epochs"] = {t: d["t"] for t, d in man.items() if "t" in d}
-        out["oscillator"] = {p.info["oscillator"]: i for i, p in enumerate(params)
-                             if p.kind == "clock" and p.owner == sc}
         return out
 
     def _break_epochs(self) -> np.ndarray:
@@ -292,12 +292,14 @@ class TrackingProblem:
         return seg
 
     def _measurement_setup(self, x0) -> MeasurementSetup:
+        """The measurement set-up with every estimated oscillator's terms from ``x0``."""
         osc = dict(self.setup.oscillators)
-        for sc, ix in self._sc.items():
-            if ix["oscillator"]:
-                y0, y1, t_ref = self.setup.oscillators[sc]
-                osc[sc] = (x0[ix["oscillator"]["y0"]] if "y0" in ix["oscillator"] else y0,
-                           x0[ix["oscillator"]["y1"]] if "y1" in ix["oscillator"] else y1, t_ref)
+        for i, p in enumerate(self.registry.parameters):
+            if p.kind == "clock":
+                terms = list(osc.get(p.owner, (0.0, 0.0, 0.0)))
+                terms[2] = p.info.get("t_ref", terms[2])
+                terms[("y0", "y1").index(p.info["oscillator"])] = x0[i]
+                osc[p.owner] = tuple(terms)
         return replace(self.setup, oscillators=osc)
 
     def _evaluate(self, lo, hi, trajs, x0):

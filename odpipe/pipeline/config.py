@@ -24,6 +24,7 @@ from typing import Literal
 import numpy as np
 
 from odpipe.estimation.fit import FitOptions
+from odpipe.measurements.bands import ONE_WAY_SCALE, band_name
 from odpipe.od.arc import DATA_SIGMA, ArcSetup
 from odpipe.operations.schema import (at_least, between, checked, file_name, finite, internal, load, positive,
                                       read_toml, readable, readable_files)
@@ -364,6 +365,24 @@ class OutwardSection:
     factor: float = checked(between(1.01, 100.0), default=2.0)  # each next window this many times wider
 
 
+def _bands(value: dict) -> list[tuple[str, str]]:
+    """Each key a downlink band name."""
+    return [(f".{k}", f"{k!r} is not a band ({', '.join(ONE_WAY_SCALE)})") for k in value
+            if band_name(k) not in ONE_WAY_SCALE]
+
+
+def _oscillator_sigmas(value) -> list[tuple[str, str]]:
+    """[y0, y1] positive, or {band: [y0, y1]}."""
+    pairs = value.items() if isinstance(value, dict) else [("", value)]
+    out = _bands(value) if isinstance(value, dict) else []
+    for band, pair in pairs:
+        where = f".{band}" if band else ""
+        out += [(where + w, r) for w, r in positive(pair)]
+        if len(pair) != 2:
+            out.append((where, f"{pair!r} must be two sigmas: [y0, y1 (1/s)]"))
+    return out
+
+
 def _angles(value, positive_only: bool = False) -> list[tuple[str, str]]:
     """Check: an angle (a number in rad, or a string with its unit) or each of a table, finite (and > 0)."""
     from odpipe.od.arc import sigma_value  # the fit's own reading of angles (imports numerics: only when checked)
@@ -387,7 +406,8 @@ class EstimationSection:
     sigma_velocity: float = checked(positive, default=ArcSetup.sigma_velocity)  # m/s, a priori, per axis
     srp_scale_sigma: float | None = checked(positive, default=ArcSetup.srp_scale_sigma)  # a priori sigma of the SRP scale (none: fixed)
     stochastic: StochasticSection | None = None  # Gauss-Markov RTN accelerations (none: off)
-    # LOS sigma (m, m/s) by "observable" or "observable:station" (the station's entry wins); angle observables:
+    # LOS sigma (m, m/s) by "observable", "observable:band" (downlink band, e.g. "doppler_1way:S") or
+    # "observable:station" (the station's entry wins, then the band's); angle observables:
     # the angle's own sigma, a number in rad or a string with its unit ("0.01 deg", "36 arcsec", "1e-4 rad")
     data_sigma: dict[str, float | str] = checked(lambda v: _data_sigmas(v),
                                                  default_factory=lambda: dict(DATA_SIGMA))
@@ -414,9 +434,16 @@ class EstimationSection:
     doppler_bias_sigma: float | None = checked(positive, default=ArcSetup.doppler_bias_sigma)
     # s, a time-tag offset per receiving station, tags late, relative to the station with the most rows (none: not estimated)
     station_time_offset_sigma: float | None = checked(positive, default=ArcSetup.time_offset_sigma)
-    # one-way Doppler's oscillator, estimated when set: sigmas of its fractional frequency offset y0 and drift
-    # y1 (1/s) about the arc start, one pair for every band it drives (a priori 0: the rows' reference)
-    oscillator_sigma: list[float] | None = checked(positive, default=None)
+    # one-way Doppler's oscillator, estimated when set: a priori sigmas of its fractional frequency offset y0
+    # (1) and drift y1 (1/s) about the arc start (a priori 0: the rows' reference): [y0, y1] one oscillator
+    # for every band it drives, or a table by downlink band, e.g. { X = [1e-6, 1e-12], S = [1e-5, 1e-10] },
+    # one oscillator per band named (the other bands' one-way rows get no oscillator terms)
+    oscillator_sigma: list[float] | dict[str, list[float]] | None = checked(lambda v: _oscillator_sigmas(v),
+                                                                            default=None)
+    # by downlink band, "pass": that band's oscillator re-estimated every pass, about the pass's mid-time (an
+    # oscillator re-tuned at each acquisition, e.g. a transponder's auxiliary one), e.g. { S = "pass" };
+    # "arc" (default): one over the arc
+    oscillator_per: dict[str, Literal["arc", "pass"]] = checked(lambda v: _bands(v), default_factory=dict)
     # planned maneuvers (parsers.maneuvers schema)
     maneuver_plan: Path | None = checked(_files_of(lambda: ("parsers.maneuvers",), "maneuver plan"), default=None)
     # s: estimate planned burns' epochs (a plan's sigma_time wins)

@@ -149,11 +149,10 @@ def arc_setup(cfg: RunConfig, fm: F.ForceModel, ramps, catalog: StationCatalog) 
     t_state, state0 = initial_state(cfg)
     if abs(t_state - start) > 1e-6:  # move the a priori state to the arc start
         state0 = propagate(state0, t_state, start, fm, with_stm=False).state(start)[0]
-    oscillators = {} if est.oscillator_sigma is None else {cfg.arc.spacecraft: (0.0, 0.0, start)}
     m = cfg.measurements
     # a fixed onboard range bias lengthens every range as a reflector that far behind the centre of mass would
     com = {cfg.arc.spacecraft: m.com_offset - m.onboard_range_bias} if m.com_offset or m.onboard_range_bias else {}
-    meas = MeasurementSetup(fm.ephemeris, catalog, ramps=ramps, gcrs_to_itrs=gcrs_to_itrs, oscillators=oscillators,
+    meas = MeasurementSetup(fm.ephemeris, catalog, ramps=ramps, gcrs_to_itrs=gcrs_to_itrs,
                             com_offsets=com, elevation_refraction=m.elevation_refraction,
                             station_displacement=station_displacement(m))
     stochastic = None if est.stochastic is None else GaussMarkov(est.stochastic.tau, est.stochastic.sigma,
@@ -173,7 +172,8 @@ def arc_setup(cfg: RunConfig, fm: F.ForceModel, ramps, catalog: StationCatalog) 
                     outward=None if est.outward is None else (t_state, est.outward.first_hours * 3600.0,
                                                                est.outward.factor),
                     doppler_bias_sigma=est.doppler_bias_sigma, time_offset_sigma=est.station_time_offset_sigma,
-                    oscillator_sigma=None if est.oscillator_sigma is None else tuple(est.oscillator_sigma),
+                    oscillator_sigma=tuple(est.oscillator_sigma) if isinstance(est.oscillator_sigma, list)
+                    else est.oscillator_sigma, oscillator_per=dict(est.oscillator_per),
                     edit_k=tuple(est.edit_k), max_iter=est.max_iter, reweight=est.reweight,
                     sigma_scale=tuple(est.sigma_scale), block=est.block,
                     measurement_epochs=est.measurement_epochs,
