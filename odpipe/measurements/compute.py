@@ -83,6 +83,8 @@ class MeasurementSetup:
     reference atmosphere at the station's height (:mod:`.refraction`).
     station_displacement: a :class:`odpipe.environment.station_displacement.StationDisplacement` (solid tide,
     ocean loading) added to every station's catalogue position at each epoch; None: catalogue positions.
+    station_partials: compute the ``station:<name>`` partial groups (off where no station position is estimated:
+    they cost a rotation per event).
     """
 
     ephemeris: object
@@ -98,6 +100,7 @@ class MeasurementSetup:
     com_offsets: dict = field(default_factory=dict)
     elevation_refraction: bool = False
     station_displacement: object = None
+    station_partials: bool = True
 
     @classmethod
     def default(cls, **kw) -> "MeasurementSetup":
@@ -481,7 +484,8 @@ def _store(out: Evaluation, idx, n, comp: Computed, roles, g, setup):
     done = set()
     for role, (kind, name, obj) in roles.items():
         if kind == "station":
-            _put(out, f"station:{name}", ["x", "y", "z"], idx, n, station_partials(comp, role, obj))
+            if setup.station_partials:
+                _put(out, f"station:{name}", ["x", "y", "z"], idx, n, station_partials(comp, role, obj))
         elif (name, role) not in done and getattr(obj, "with_stm", hasattr(obj, "stm")):  # no STM: values only
             done.add((name, role))
             _put(out, f"state:{name}", ["x", "y", "z", "vx", "vy", "vz"], idx, n, epoch_state_partials(comp, role, obj))

@@ -312,7 +312,8 @@ class TrackingProblem:
             self._prepared[(lo, hi)] = prepare(self.rows.iloc[lo:hi])
         prepared = self._prepared[(lo, hi)]
         rows = prepared.rows
-        setup = self._measurement_setup(x0)
+        setup = replace(self._measurement_setup(x0),
+                        station_partials=any(p.kind == "station" for p in self.registry.parameters))
         ev = compute(rows, trajs, setup, prepared)
         res, _ = residuals(rows, ev)
         observed = rows["value"].to_numpy(float)
