@@ -30,19 +30,32 @@ def event_gradient(computed: Computed, role: str) -> list[tuple[np.ndarray, np.n
     return out
 
 
+def _at_events(grads, fn) -> list[np.ndarray]:
+    """``fn`` (a trajectory's ``stm`` or ``sensitivity``) at the epochs of each event of ``grads``, evaluated once
+    per distinct epoch (a Doppler count's end is the next count's start)."""
+    t = np.concatenate([t for t, _ in grads])
+    epochs, which = np.unique(t, return_inverse=True)
+    values = np.asarray(fn(epochs))[which.ravel()]
+    return np.split(values, np.cumsum([t.size for t, _ in grads])[:-1])
+
+
 def epoch_state_partials(computed: Computed, role: str, trajectory) -> np.ndarray:
     """d value / d (epoch state of ``trajectory``), (N,6), summing the events of ``role``."""
     total = np.zeros((computed.value.size, 6))
-    for t, g in event_gradient(computed, role):
-        total += np.einsum("ni,nij->nj", g, np.asarray(trajectory.stm(t)).reshape(t.size, 6, 6))
+    grads = event_gradient(computed, role)
+    if grads:
+        for (_, g), stm in zip(grads, _at_events(grads, trajectory.stm)):
+            total += np.einsum("ni,nij->nj", g, stm.reshape(-1, 6, 6))
     return total
 
 
 def dynamic_partials(computed: Computed, role: str, trajectory) -> np.ndarray:
     """d value / d (dynamic parameters of ``trajectory``), (N,p), through ``trajectory.sensitivity``."""
     grads = event_gradient(computed, role)
-    parts = [np.einsum("ni,nip->np", g, np.asarray(trajectory.sensitivity(t))) for t, g in grads]
-    return sum(parts[1:], parts[0]) if parts else np.zeros((computed.value.size, 0))
+    if not grads:
+        return np.zeros((computed.value.size, 0))
+    parts = [np.einsum("ni,nip->np", g, s) for (_, g), s in zip(grads, _at_events(grads, trajectory.sensitivity))]
+    return sum(parts[1:], parts[0])
 
 
 def station_partials(computed: Computed, role: str, station_node) -> np.ndarray:
