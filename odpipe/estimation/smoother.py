@@ -2,9 +2,9 @@
 
 Runs backwards over an :class:`~odpipe.estimation.srif.SRIF` log, starting from
 the final filtered information array. A deterministic map ``dx+ = Phi dx`` is
-undone as ``R* <- R* Phi`` (a compiled run of them for :meth:`~.srif.SRIF.intervals`); a colored-noise step combines the smoothed array of
-``dx+`` with the rows the filter eliminated (which tie ``p_old`` to ``dx+``) and
-marginalizes ``p_new``. Measurement updates need no backward work: between
+undone as ``R* <- R* Phi`` (a compiled run of them for :meth:`~.srif.SRIF.intervals`);
+a colored-noise step combines the smoothed array of ``dx+`` with the rows the filter
+eliminated (which tie ``p_old`` to ``dx+``) and marginalizes ``p_new``. Measurement updates need no backward work: between
 process-noise steps the smoothed estimate is the mapped final one.
 """
 
