@@ -4,10 +4,10 @@ Real data live in ``../shared/data`` beside the project (``ODPIPE_SHARED_DATA``
 overrides). Outside CI, tests marked ``realdata`` skip with a message when the
 folder is absent; under ``CI=true`` its absence is a failure.
 
-Files holding a test marked ``slow`` run first, whole and in their own order, so that
-``make test``'s workers (pytest-xdist, whole files per worker) start the long ones early and
-finish together; among them, the files of ``LONGEST_FIRST`` lead in its order (longest first:
-a long file started last would leave one worker running it alone).
+The files of ``LONGEST_FIRST`` run first, in its order (longest first: a long file started last
+would leave one worker running it alone), then the other files holding a test marked ``slow``,
+then the rest, each file whole and its tests in their own order, so that ``make test``'s workers
+(pytest-xdist, whole files per worker) start the long ones early and finish together.
 """
 
 from __future__ import annotations
@@ -19,12 +19,14 @@ import pytest
 
 ROOT = Path(__file__).resolve().parents[1]
 SHARED_DATA = Path(os.environ.get("ODPIPE_SHARED_DATA", ROOT.parent / "shared" / "data"))
-# the longest files, longest first (CPU seconds of each file run alone under load, 2026-11-26 07:20-08:10 UTC:
-# 107, 98, 90, 46, 40, 40, 37); a scheduling hint only: a file missing here runs after these, with the other
-# slow files
-LONGEST_FIRST = ("test_study_ground_and_crosslink.py", "test_messenger.py", "test_demo_twin.py",
-                 "test_batch_faults.py", "test_study_halo_geo_doppler.py", "test_od_long_arc.py", "test_grail_arc.py",
-                 "test_estimation_covariance_realism.py", "test_runs.py")
+# the longest files, longest first, whether marked slow or not (CPU seconds of each file in a whole make test
+# under load, 2026-11-26 10:05-10:32 UTC, with the MESSENGER and test_runs figures after that day's changes:
+# 78, 52, 40, 34 (its wall is longer: it waits for kills), 29, 29, 21, 19, 18, 16, 11, 9, 8); a scheduling hint
+# only: a file missing here runs after these, with the other slow files or the rest
+LONGEST_FIRST = ("test_study_ground_and_crosslink.py", "test_demo_twin.py", "test_messenger.py", "test_batch_faults.py",
+                 "test_study_halo_geo_doppler.py", "test_od_long_arc.py", "test_grail_arc.py", "test_readers_fuzz.py",
+                 "test_study_dro_leo_dowr.py", "test_estimation_covariance_realism.py", "test_runs.py", "test_crlb.py",
+                 "test_measurements_mro_range.py")
 
 
 def _in_ci() -> bool:
@@ -39,7 +41,7 @@ def pytest_collection_modifyitems(config, items):
     slow_files = {item.path for item in items if "slow" in item.keywords}
     rank = {name: k for k, name in enumerate(LONGEST_FIRST)}
     # stable: each file stays in one piece
-    items.sort(key=lambda item: (item.path not in slow_files, rank.get(item.path.name, len(rank))))
+    items.sort(key=lambda item: (rank.get(item.path.name, len(rank)), item.path not in slow_files))
 
 
 @pytest.fixture(scope="session")

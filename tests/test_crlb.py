@@ -99,8 +99,9 @@ def test_montecarlo_rms_matches_crlb():
     ratio = rms_over_runs(err[:, None, :])[0] ** 2 / np.diag(P)
     lo, hi = chi2.ppf([0.0005, 0.9995], n) / n
     assert np.all((ratio > lo) & (ratio < hi)), ratio
-    assert np.array_equal(err, np.array(monte_carlo(_kf_trial, n, seed=11)))   # seeded
-    assert not np.array_equal(err, np.array(monte_carlo(_kf_trial, n, seed=12)))
+    # seeded: each run draws from its own generator, spawned by index, so the first runs again are the same
+    assert np.array_equal(err[:30], np.array(monte_carlo(_kf_trial, 30, seed=11)))
+    assert not np.array_equal(err[:30], np.array(monte_carlo(_kf_trial, 30, seed=12)))
 
 
 def test_montecarlo_parallel_equals_serial():

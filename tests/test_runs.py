@@ -108,25 +108,44 @@ def _arcs(tmp_path, n, seconds, fail=()):
     return paths
 
 
+@pytest.fixture(scope="module")
+def scheduler():
+    """Address of a local Dask cluster of two single-threaded worker processes, started once for this module's
+    in-process batches (each run_batch of its own would start and stop one: seconds of CPU and wall each). The
+    cluster that run_batch starts itself is exercised by the killed batch's subprocess below."""
+    from distributed import LocalCluster
+
+    old = os.environ.get("PYTHONPATH")
+    os.environ["PYTHONPATH"] = str(ROOT)          # the workers import tests.batch_job
+    try:
+        cluster = LocalCluster(n_workers=2, threads_per_worker=1, processes=True, dashboard_address=":0")
+    finally:
+        if old is None:
+            del os.environ["PYTHONPATH"]
+        else:
+            os.environ["PYTHONPATH"] = old
+    yield cluster.scheduler_address
+    cluster.close()
+
+
 @pytest.mark.slow
-def test_one_failing_arc_does_not_stop_the_batch(tmp_path, monkeypatch):
-    monkeypatch.setenv("PYTHONPATH", str(ROOT))
+def test_one_failing_arc_does_not_stop_the_batch(tmp_path, scheduler):
     from tests.batch_job import run_arc
     configs = _arcs(tmp_path, 3, 0, fail={1})
-    out = {Path(o.config).stem: o for o in run_batch(configs, run_arc, workers=2, progress=lambda s: None)}
+    out = {Path(o.config).stem: o for o in run_batch(configs, run_arc, scheduler=scheduler, progress=lambda s: None)}
     assert [out[f"arc{k}"].status for k in range(3)] == ["complete", "failed", "complete"]
     assert "told to fail" in out["arc1"].error
     assert "1 failed" in night_summary(list(out.values()))
-    again = run_batch(configs, run_arc, workers=2, progress=lambda s: None)
+    again = run_batch(configs, run_arc, scheduler=scheduler, progress=lambda s: None)
     assert sorted(o.status for o in again) == ["failed", "skipped", "skipped"]
 
 
-def test_chained_arcs_run_after_their_source_and_not_after_a_failure(tmp_path, monkeypatch):
-    monkeypatch.setenv("PYTHONPATH", str(ROOT))
+def test_chained_arcs_run_after_their_source_and_not_after_a_failure(tmp_path, scheduler):
     from tests.batch_job import run_arc
     c = _arcs(tmp_path, 4, 0.5, fail={0})
     after = {c[1]: [c[0]], c[2]: [c[3]]}   # arc1 starts from the failing arc0, arc2 from arc3
-    outcomes = run_batch([c[2], c[1], c[0], c[3]], run_arc, after=after, workers=2, progress=lambda s: None)
+    outcomes = run_batch([c[2], c[1], c[0], c[3]], run_arc, after=after, scheduler=scheduler,
+                         progress=lambda s: None)
     order = [Path(o.config).stem for o in outcomes]
     out = {Path(o.config).stem: o for o in outcomes}
     assert out["arc0"].status == "failed" and out["arc1"].status == "failed"
@@ -137,7 +156,7 @@ def test_chained_arcs_run_after_their_source_and_not_after_a_failure(tmp_path, m
         dependency_order(["a", "b"], {"a": ["b"], "b": ["a"]})
 
 
-def test_batch_killed_midway_resumes_without_redoing_arcs(tmp_path, monkeypatch):
+def test_batch_killed_midway_resumes_without_redoing_arcs(tmp_path, scheduler):
     configs = _arcs(tmp_path, 5, 2.0)
     script = ("import sys; from pathlib import Path; from odpipe.operations.nightly import run_batch;"
               "from tests.batch_job import run_arc;"
@@ -153,9 +172,8 @@ def test_batch_killed_midway_resumes_without_redoing_arcs(tmp_path, monkeypatch)
     proc.wait()
     done = {p.parent.name: json.loads((p / "manifest.json").read_text())["finished"] for p in out.glob("*/current")}
     assert 2 <= len(done) < 5, "the batch should have been killed midway"
-    monkeypatch.setenv("PYTHONPATH", str(ROOT))
     from tests.batch_job import run_arc
-    outcomes = run_batch(configs, run_arc, workers=2, progress=lambda s: None)
+    outcomes = run_batch(configs, run_arc, scheduler=scheduler, progress=lambda s: None)
     status = {Path(o.config).stem: o.status for o in outcomes}
     assert all(status[name] == "skipped" for name in done)
     assert all(status[f"arc{k}"] == "complete" for k in range(5) if f"arc{k}" not in done)

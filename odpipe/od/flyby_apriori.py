@@ -56,9 +56,13 @@ def radial_distance(tau, mu: float, v_inf: float) -> np.ndarray:
     """Distance (m) on the radial hyperbola (speed ``v_inf`` m/s at infinity) ``tau`` s before it reaches the centre."""
     tau = np.asarray(tau, float)
     m = tau * v_inf ** 3 / mu  # = sinh F - F
-    f = np.arcsinh(m) + 1.0  # Newton from above the root (sinh F - F is convex for F > 0)
-    for _ in range(60):
-        f = f - (np.sinh(f) - f - m) / (np.cosh(f) - 1.0)
+    f = prev = np.arcsinh(m) + 1.0  # Newton from above the root (sinh F - F is convex for F > 0), 60 steps
+    for k in range(60):
+        step = f - (np.sinh(f) - f - m) / (np.cosh(f) - 1.0)
+        if np.array_equal(step, prev, equal_nan=True):   # every value now repeats with period 1 or 2:
+            f = step if (59 - k) % 2 == 0 else f                 # the 60th step's is the one of its parity
+            break
+        prev, f = f, step
     return mu / v_inf ** 2 * (np.cosh(f) - 1.0)
 
 
