@@ -15,6 +15,7 @@ The batch configuration (``[batch]`` table) is :class:`BatchSection`.
 from __future__ import annotations
 
 import logging
+import threading
 import time
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -92,15 +93,26 @@ def dependency_order(configs: list[str], after: dict) -> list[str]:
     return order
 
 
+def _warmed(warm: Callable[[list], None], configs: list) -> None:
+    try:
+        warm([Path(c) for c in configs])
+    except Exception as exc:  # a worker that could not be warmed still runs its arcs (then paying the start-up)
+        _log.warning("warming a worker failed: %s", describe(exc)[1])
+
+
 def run_batch(configs, run_one: Callable[[Path], dict], *, after: dict | None = None, scheduler: str | None = None,
               workers: int = 2, progress: Callable[[str], None] = _log.info,
-              failed: dict | None = None) -> list[ArcOutcome]:
+              failed: dict | None = None, warm: Callable[[list], None] | None = None) -> list[ArcOutcome]:
     """Run every arc config; returns one outcome per arc in completion order.
 
     ``after``: config -> configs whose products it starts from (run first). ``scheduler``
     is the address of a running Dask scheduler; without it a local cluster of ``workers``
-    single-threaded processes is started. ``failed``: config -> why it cannot run (e.g. its
-    configuration does not load): reported failed first, with the arcs that start from it.
+    single-threaded processes is started (and closed in the background once every arc is
+    done, while the caller goes on: its workers take seconds to exit). ``failed``: config ->
+    why it cannot run (e.g. its configuration does not load): reported failed first, with the
+    arcs that start from it. ``warm(configs)``: run once in every worker at a lower priority than
+    the arcs, so a worker that waits for a chain's first arc pays its imports and loads then
+    (:func:`odpipe.pipeline.warmup.warm_worker`); its failure is logged, never fatal.
     """
     from distributed import Client, LocalCluster, as_completed
 
@@ -121,13 +133,17 @@ def run_batch(configs, run_one: Callable[[Path], dict], *, after: dict | None = 
         for i, c in enumerate(configs):
             deps = [broken[d] if d in broken else futures[d] for d in after.get(c, ()) if d in broken or d in futures]
             futures[c] = client.submit(_guarded, run_one, c, *deps, key=f"arc-{i}", pure=False)
+        if warm is not None:   # after the arcs: a worker given the first arc runs this only when idle
+            for k, address in enumerate(client.scheduler_info()["workers"]):
+                client.submit(_warmed, warm, configs, key=f"warm-{k}", workers=[address],
+                              allow_other_workers=False, priority=-1, pure=False)
         for fut in as_completed(list(futures.values())):
             out = fut.result()
             outcomes.append(out)
             note = f": {out.error}" if out.error else ""
             progress(f"[{len(outcomes)}/{total}] {Path(out.config).name}: {out.status} in {out.seconds:.1f} s{note}")
-    if cluster is not None:
-        cluster.close()
+    if cluster is not None:   # the caller's summary and report need no worker
+        threading.Thread(target=cluster.close, name="close the local Dask cluster").start()
     return outcomes
 
 
