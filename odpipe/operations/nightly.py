@@ -93,6 +93,18 @@ def dependency_order(configs: list[str], after: dict) -> list[str]:
     return order
 
 
+def _local_cluster(workers: int):
+    """``workers`` single-threaded worker processes on any free port (never clashing with a running cluster),
+    with glibc's own heap trimming: Dask's default ``MALLOC_TRIM_THRESHOLD_`` of 64 kB also fixes glibc's mmap
+    threshold, so every array above 128 kB is mapped and unmapped again (a GRAIL arc: 5x the page faults,
+    3x the system time and 26 % more CPU in all than the same arc in a plain process)."""
+    import dask
+    from distributed import LocalCluster
+
+    with dask.config.set({"distributed.nanny.pre-spawn-environ.MALLOC_TRIM_THRESHOLD_": None}):
+        return LocalCluster(n_workers=workers, threads_per_worker=1, processes=True, dashboard_address=":0")
+
+
 def _warmed(warm: Callable[[list], None], configs: list) -> None:
     try:
         warm([Path(c) for c in configs])
@@ -114,7 +126,7 @@ def run_batch(configs, run_one: Callable[[Path], dict], *, after: dict | None = 
     the arcs, so a worker that waits for a chain's first arc pays its imports and loads then
     (:func:`odpipe.pipeline.warmup.warm_worker`); its failure is logged, never fatal.
     """
-    from distributed import Client, LocalCluster, as_completed
+    from distributed import Client, as_completed
 
     after = {str(c): [str(d) for d in ds] for c, ds in (after or {}).items()}
     broken = {str(c): ArcOutcome(str(c), "failed", 0.0, error=why) for c, why in (failed or {}).items()}
@@ -126,8 +138,7 @@ def run_batch(configs, run_one: Callable[[Path], dict], *, after: dict | None = 
     configs = [c for c in dependency_order([str(c) for c in configs], after) if c not in broken]
     if not configs:
         return outcomes
-    cluster = None if scheduler else LocalCluster(n_workers=workers, threads_per_worker=1,
-                                                  processes=True, dashboard_address=":0")  # any free port: never clash with a running cluster
+    cluster = None if scheduler else _local_cluster(workers)
     with Client(scheduler or cluster) as client:
         futures = {}
         for i, c in enumerate(configs):
