@@ -20,12 +20,8 @@ from pathlib import Path
 
 import numpy as np
 
-from odpipe.dynamics.compile_timer import compile_timer
-from odpipe.dynamics.crtbp import crtbp_rhs
 from odpipe.dynamics.forces import ForceModel
 from odpipe.dynamics.propagator import propagate
-from odpipe.environment.atmosphere.nrlmsise00 import gtd7
-from odpipe.pipeline.demo import run_demo
 
 DAYS = 11.0  # two station-keeping maneuvers (days 3.5 and 10.5) and an attitude burn: short and long arcs
 GM_EARTH = 3.986004415e14  # m^3/s^2
@@ -35,6 +31,9 @@ def other_kernels() -> None:
     """One call of each kernel signature outside the demo: RK4 through the compiled force model
     (one type for every model), ``crtbp_rhs`` on writable arrays (``studies.crtbp_orbits``) and
     ``gtd7`` on writable arrays (drag and direct calls differ in array mutability)."""
+    from odpipe.dynamics.crtbp import crtbp_rhs
+    from odpipe.environment.atmosphere.nrlmsise00 import gtd7
+
     x0 = np.array([7.0e6, 0.0, 0.0, 0.0, 7.5e3, 0.0])
     propagate(x0, 0.0, 120.0, ForceModel("earth", central_gm=GM_EARTH), with_stm=True, method="rk4", max_step=60.0)
     crtbp_rhs(0.0, np.array([0.82, 0.0, 0.1, 0.0, 0.2, 0.0]), np.array([0.0121]), np.empty(6))
@@ -77,6 +76,9 @@ def warm_worker(configs: list) -> None:
 
 def warm_up(days: float = DAYS) -> str:
     """Run the shortened demo in a temporary folder, then :func:`other_kernels`; one line on what was compiled."""
+    from odpipe.dynamics.compile_timer import compile_timer
+    from odpipe.pipeline.demo import run_demo
+
     t0 = time.perf_counter()
     lines: list[str] = []
     with tempfile.TemporaryDirectory(prefix="odpipe-warmup-") as tmp:
