@@ -107,3 +107,19 @@ def test_shadr_table_from_spec(tmp_path, shared_data):
     g = read_gravity(path)
     assert g.gm == pytest.approx(ref.gm, rel=1e-15) and g.radius == ref.radius
     np.testing.assert_array_equal(g.C, ref.C)
+
+
+def test_a_field_read_again_is_the_same_until_its_file_changes(tmp_path, shared_data):
+    """read_gravity keeps what it read: the same object again (one parse per batch worker), the epoch
+    ignored for a format without time-variable terms; a rewritten file is read again."""
+    lpe = shared_data / "gravity/tudat/lpe200.txt"
+    assert read_gravity(lpe, epoch=0.0) is read_gravity(lpe, epoch=YEAR_S)
+    path = tmp_path / "field.txt"
+    path.write_text("4.9028e12 1738000.0\n2 0 -9.0e-5 0.0\n")
+    first = read_gravity(path)
+    path.write_text("4.9028e12 1738000.0\n2 0 -9.1e-5 0.0\n3 0 1.0e-5 0.0\n")
+    second = read_gravity(path)
+    assert first.C[2, 0] == -9.0e-5 and second.C[2, 0] == -9.1e-5 and second.max_degree == 3
+    icgem = shared_data / "gravity/orekit/eigen-6s-truncated"
+    a, b = read_gravity(icgem, epoch=0.0), read_gravity(icgem, epoch=YEAR_S)
+    assert a is not b and a.C[2, 0] != b.C[2, 0]

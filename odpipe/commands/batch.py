@@ -125,8 +125,10 @@ def run(args) -> int:
     arcs = sorted(set(batch.arcs))
     overlap_arcs = None if batch.overlaps is None else set(batch.overlaps)
     cfgs, broken = arc_configs(arcs)
+    from odpipe.pipeline.warmup import warm_worker
     outcomes = run_batch(arcs, _arc_forced if args.force else _arc, after=starts_from(arcs, cfgs, broken),
-                         scheduler=args.scheduler, workers=args.workers or batch.workers, failed=broken)
+                         scheduler=args.scheduler, workers=args.workers or batch.workers, failed=broken,
+                         warm=warm_worker)
     print(night_summary(outcomes))
     if batch.report is not None:
         print(f"report: {night_report(batch.report, arcs, outcomes, overlap_arcs)}")

@@ -77,6 +77,26 @@ def _field_table(field: GravityField, degree: int, grad_degree: int):
     return table
 
 
+_ROTATIONS: dict = {}  # (frame, lo, hi, segment, degree) -> fitted rotation channel: each reference segment of
+_ROTATIONS_KEPT = 512  # an arc is integrated again at every fit pass over the same span
+
+
+def _rotation_channel(s: SphericalHarmonics, lo: float, hi: float):
+    """The Chebyshev table of ``s``'s ICRF-to-body-fixed rotation over [lo, hi], fitted once per span and
+    frame (a given ``rotation`` function: by identity; else the body's default frame)."""
+    body = s.body.lower()
+    seg, deg = ROTATION_GRID.get(body, (3600.0, 12))
+    key = (body if s.rotation is None else s.rotation, lo, hi, seg, deg)
+    hit = _ROTATIONS.get(key)
+    if hit is None:
+        rot = s.rotation or default_rotation(body)
+        hit = fit_channel(lambda t: np.asarray(rot(t)).reshape(-1, 9), lo, hi, seg, deg)
+        while len(_ROTATIONS) >= _ROTATIONS_KEPT:
+            _ROTATIONS.pop(next(iter(_ROTATIONS)))
+        _ROTATIONS[key] = hit
+    return hit
+
+
 def _compile(components, ctx) -> HarmonicsData:
     n = len(components)
     gm, radius = np.zeros(n), np.zeros(n)
@@ -85,17 +105,18 @@ def _compile(components, ctx) -> HarmonicsData:
     channels = []
     for k, s in enumerate(components):
         body = s.body.lower()
-        rot = s.rotation or default_rotation(body)
-        seg, deg = ROTATION_GRID.get(body, (3600.0, 12))
-        channels.append(fit_channel(lambda t, rot=rot: np.asarray(rot(t)).reshape(-1, 9), ctx.lo, ctx.hi, seg, deg))
+        channels.append(_rotation_channel(s, ctx.lo, ctx.hi))
         gm[k], radius[k], degree[k] = s.field.gm, s.field.radius, s.degree
         grad_degree[k] = (s.degree if s.partial_degree is None else s.partial_degree) if ctx.with_stm else -1
         slot[k] = ctx.slot.get(body, -1) if body != ctx.center else -1
         tables.append(_field_table(s.field, s.degree, int(grad_degree[k])))
     rot_coefs, rot_meta = stack_channels(channels)
-    T = np.zeros((max(1, n), ROWS, max([t.shape[1] for t in tables] + [1])))
-    for k, t in enumerate(tables):
-        T[k, :, : t.shape[1]] = t
+    if n == 1:   # the one field's table as it is (1.8 MB at degree 150: no copy per segment)
+        T = np.ascontiguousarray(tables[0])[np.newaxis]
+    else:
+        T = np.zeros((max(1, n), ROWS, max([t.shape[1] for t in tables] + [1])))
+        for k, t in enumerate(tables):
+            T[k, :, : t.shape[1]] = t
     work = np.concatenate([workspace(int(degree.max(initial=2)), int(grad_degree.max(initial=-1))),
                            np.zeros(FRAME_SCRATCH)])
     return HarmonicsData(T, gm, radius, degree, grad_degree, slot, rot_coefs, rot_meta, work)

@@ -49,6 +49,9 @@ class Trajectory:
         lo, hi = min(self.t0, self.t1), max(self.t0, self.t1)
         if np.any((t < lo) | (t > hi)):
             raise ValueError(f"epoch outside the trajectory arc [{lo}, {hi}] TDB s")
+        if len(self._pieces) == 1:   # one integration segment (no restart inside the arc): no lookup
+            ts, ys, Fs = self._pieces[0]
+            return dense(ts, ys, Fs, np.ascontiguousarray(t.ravel())) if len(ts) > 1 else np.repeat(ys[:1], t.size, axis=0)
         n = self._pieces[0][1].shape[1]
         out = np.empty((t.size, n))
         idx = np.clip(np.searchsorted(self._starts, t, side="right") - 1, 0, len(self._pieces) - 1)

@@ -298,18 +298,42 @@ def sniff_format(path: Path, lines: list[str]) -> str:
     return "egm"
 
 
+_READ: dict = {}  # (path, size, mtime, fmt, gm, radius) -> (epoch of an ICGEM file's terms, field) read here
+_READ_KEPT = 4
+_ANY_EPOCH = object()  # the field of a format without time-variable terms, whatever the epoch asked
+
+
 def read_gravity(path, *, epoch: float | None = None, fmt: str | None = None,
                  gm: float = EGM96_GM, radius: float = EGM96_RADIUS) -> GravityField:
     """Read a gravity field file (format sniffed unless ``fmt`` given).
 
     ``epoch``: TDB seconds past J2000 at which time-variable ICGEM terms are
     evaluated. ``gm``/``radius`` apply only to the EGM format (not in the file).
+    A process keeps the last few fields it read (keyed by path, size, modification
+    time and the arguments; the epoch for ICGEM files only) and returns the same object
+    again: a batch worker parses a field once for all its arcs, and the field's packed
+    kernel table is then reused (:mod:`odpipe.dynamics.gravity_fields`). Fields are never
+    modified in place.
     """
     path = Path(path)
+    stat = path.stat()
+    key = (str(path.resolve()), stat.st_size, stat.st_mtime_ns, fmt, gm, radius)
+    held = _READ.get(key)
+    if held is not None and held[0] in (_ANY_EPOCH, epoch):
+        return held[1]
     lines = _lines(path)
     if not lines:
         raise ParseError(path, "empty file")
     fmt = fmt or sniff_format(path, lines)
+    field = _parse(path, lines, fmt, epoch, gm, radius)
+    _READ.pop(key, None)
+    while len(_READ) >= _READ_KEPT:
+        _READ.pop(next(iter(_READ)))
+    _READ[key] = (epoch if fmt == "icgem" else _ANY_EPOCH, field)
+    return field
+
+
+def _parse(path: Path, lines: list[str], fmt: str, epoch, gm, radius) -> GravityField:
     if fmt == "icgem":
         return _read_icgem(path, lines, epoch)
     if fmt == "cof":

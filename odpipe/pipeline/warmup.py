@@ -20,12 +20,8 @@ from pathlib import Path
 
 import numpy as np
 
-from odpipe.dynamics.compile_timer import compile_timer
-from odpipe.dynamics.crtbp import crtbp_rhs
 from odpipe.dynamics.forces import ForceModel
 from odpipe.dynamics.propagator import propagate
-from odpipe.environment.atmosphere.nrlmsise00 import gtd7
-from odpipe.pipeline.demo import run_demo
 
 DAYS = 11.0  # two station-keeping maneuvers (days 3.5 and 10.5) and an attitude burn: short and long arcs
 GM_EARTH = 3.986004415e14  # m^3/s^2
@@ -35,14 +31,54 @@ def other_kernels() -> None:
     """One call of each kernel signature outside the demo: RK4 through the compiled force model
     (one type for every model), ``crtbp_rhs`` on writable arrays (``studies.crtbp_orbits``) and
     ``gtd7`` on writable arrays (drag and direct calls differ in array mutability)."""
+    from odpipe.dynamics.crtbp import crtbp_rhs
+    from odpipe.environment.atmosphere.nrlmsise00 import gtd7
+
     x0 = np.array([7.0e6, 0.0, 0.0, 0.0, 7.5e3, 0.0])
     propagate(x0, 0.0, 120.0, ForceModel("earth", central_gm=GM_EARTH), with_stm=True, method="rk4", max_step=60.0)
     crtbp_rhs(0.0, np.array([0.82, 0.0, 0.1, 0.0, 0.2, 0.0]), np.array([0.0121]), np.empty(6))
     gtd7(172, 29000.0, 400.0, 60.0, -70.0, 16.0, 150.0, 150.0, 4.0)
 
 
+def warm_worker(configs: list) -> None:
+    """What a batch worker's first arc would otherwise pay before its fit (``run_batch(..., warm=)``): the
+    run's imports, matplotlib's, and for each distinct force model of ``configs`` (run configuration files)
+    its gravity files (kept per process, :func:`odpipe.environment.gravity.read_gravity`) and a minute of
+    its dynamics with the STM and an RTN batch as a fit segment flies it (loading those kernels from
+    numba's cache). A configuration that does not load is passed over: its arc reports that."""
+    from dataclasses import replace
+
+    import matplotlib
+    matplotlib.use("Agg")
+    import matplotlib.pyplot  # noqa: F401  (the products' residual plots)
+
+    from odpipe.dynamics.forces import BODY_RADIUS, EmpiricalRTN
+    from odpipe.pipeline import run  # noqa: F401  (every stage's imports)
+    from odpipe.pipeline.config import load_config
+    from odpipe.pipeline.setup import force_model, tdb
+
+    seen = set()
+    for path in configs:
+        try:
+            cfg = load_config(path)
+        except (ValueError, OSError):
+            continue
+        key = repr(cfg.dynamics)
+        if key in seen:
+            continue
+        seen.add(key)
+        fm = force_model(cfg)
+        t0 = tdb(cfg.arc.start)
+        r = 3.0 * BODY_RADIUS.get(fm.center, 6.4e6)
+        fm = replace(fm, components=list(fm.components) + [EmpiricalRTN(np.array([[t0 - 1.0, t0 + 61.0, 0, 0, 0]]))])
+        propagate(np.array([r, 0.0, 0.0, 0.0, 1.0e3, 0.0]), t0, t0 + 60.0, fm).state(t0 + 30.0)
+
+
 def warm_up(days: float = DAYS) -> str:
     """Run the shortened demo in a temporary folder, then :func:`other_kernels`; one line on what was compiled."""
+    from odpipe.dynamics.compile_timer import compile_timer
+    from odpipe.pipeline.demo import run_demo
+
     t0 = time.perf_counter()
     lines: list[str] = []
     with tempfile.TemporaryDirectory(prefix="odpipe-warmup-") as tmp:
