@@ -166,7 +166,7 @@ def plot(res: pd.DataFrame, path, which: str = "postfit", title: str = "") -> No
     residuals, stations coloured; edited rows drawn as grey crosses; time axis UTC.
 
     Drawn on a bare Agg figure (no pyplot, no tight layout: fixed margins, one draw per PNG), one marker
-    line per station and one for the edited rows, the markers rasterized."""
+    line per station and one for the edited rows."""
     from matplotlib.backends.backend_agg import FigureCanvasAgg
     from matplotlib.dates import DateFormatter, date2num
     from matplotlib.figure import Figure
@@ -191,10 +191,10 @@ def plot(res: pd.DataFrame, path, which: str = "postfit", title: str = "") -> No
         for station in sorted(set(stations[~edited])):
             sel = ~edited & (stations == station)
             y = y_all[sel]
-            ax.plot(t_all[sel], y, ".", ms=3, rasterized=True,
+            ax.plot(t_all[sel], y, ".", ms=3,
                     label=f"{station} (RMS {significant(np.sqrt(np.mean(y**2)))} {unit})")
         if edited.any():
-            ax.plot(t_all[edited], y_all[edited], "x", color="0.6", ms=3, rasterized=True,
+            ax.plot(t_all[edited], y_all[edited], "x", color="0.6", ms=3,
                     label=f"edited ({int(edited.sum())})")
             if (~edited).any():
                 lim = np.nanpercentile(np.abs(y_all[~edited]), 99.9) * 3
