@@ -92,7 +92,8 @@ def night_report(out: Path, arcs: list[Path], outcomes, overlap_arcs: list[Path]
         write_csv(out / "residual_statistics.csv", stats, index=False)
         sections.append(Section("Post-fit residuals per arc and station").text(
             "Along the line of sight (Doppler mm/s, range m), and the post-fit RMS in the observable's unit; "
-            "per pass in each run's residual_statistics_passes.csv").tables(residuals.report_tables(stats)))
+            "per pass in each run's residual_statistics_passes.csv. "
+            f"{residuals.PREFIT_MEANING}, {residuals.ONE_WAY_PREFIT}.").tables(residuals.report_tables(stats)))
     seq = [(name, run) for _, name, run, a in done if overlap_arcs is None or a in overlap_arcs]
     table, pngs = consecutive_overlaps({name: oem_trajectory(run / "trajectory.oem") for name, run in seq},
                                        [name for name, _ in seq], out, "arcs", "Consecutive-arc", step=60.0)

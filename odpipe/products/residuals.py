@@ -28,8 +28,9 @@ def display_scale(observable: str) -> tuple[float, str]:
     return (1e3, "mm/s") if is_rate(observable) else (1.0, "m")
 
 
-PREFIT_MEANING = ("pre-fit: observed − computed on the a priori orbit (the arc's a priori state and force "
+PREFIT_MEANING = ("Pre-fit: observed − computed on the a priori orbit (the arc's a priori state and force "
                   "parameters, the fit's first reference)")
+ONE_WAY_PREFIT = "the one-way Doppler with its oscillator at the fitted offset and drift"
 
 
 def apriori_orbit_los(arc) -> np.ndarray:
@@ -64,10 +65,9 @@ def prefit_note(res: pd.DataFrame) -> str:
     oneway = res["observable"].astype(str).eq("doppler_1way") & res["status"].eq("")
     shift = (res.loc[oneway, "apriori_los"] - res.loc[oneway, "apriori_orbit_los"]).to_numpy(float) * 1e3
     if not oneway.any() or not np.any(shift):
-        return PREFIT_MEANING[0].upper() + PREFIT_MEANING[1:] + "."
-    return (PREFIT_MEANING[0].upper() + PREFIT_MEANING[1:] + "; the one-way Doppler with the oscillator at its "
-            "fitted offset and drift: its a priori (zero) is no prediction, and against it every one-way row "
-            f"would read {significant(np.median(shift))} mm/s (−c × fitted offset) more.")
+        return PREFIT_MEANING + "."
+    return (f"{PREFIT_MEANING}; {ONE_WAY_PREFIT}: its a priori (zero) is no prediction, and against it every "
+            f"one-way row would read {significant(np.median(shift))} mm/s (−c × fitted offset) more.")
 
 
 def _rms(x) -> float:
