@@ -162,7 +162,7 @@ def _a_priori(tmp: Path):
 def test_one_way_prefit_is_the_a_priori_orbit_with_the_fitted_oscillator(run):
     """The pre-fit one-way residuals (table, plot) are observed − computed by the measurement model on the
     a priori orbit with the oscillator at its fitted offset and drift, to 2e-5 of c y0; against the
-    oscillator's zero a priori they would read −c y0 (4.5 m/s), which the report states."""
+    oscillator's zero a priori they would be offset by −c y0 (4.5 m/s), which the report states."""
     from odpipe.constants import C_LIGHT
     from odpipe.measurements import compute, residuals as observed_minus_computed
     from odpipe.operations.report import significant
@@ -187,7 +187,7 @@ def test_one_way_prefit_is_the_a_priori_orbit_with_the_fitted_oscillator(run):
     assert one_way["prefit_rms"].to_numpy() == pytest.approx(rms, abs=bound)
     assert (one_way["prefit_rms"] < 0.01 * C_LIGHT * Y0).all()   # the oscillator's offset is not in it
     page = (path / "report.html").read_text()
-    assert f"would read {significant(shift)} mm/s" in html.unescape(page)
+    assert f"would be offset by {significant(shift)} mm/s" in html.unescape(page)
     section = page.split("<h2>Residuals per station")[1].split("<h2>")[0]
     assert "<h3>doppler_1way (observed in Hz)</h3>" in section   # the first of the tables (sorted by observable)
     shown = pd.read_html(StringIO(section))[0]

@@ -67,7 +67,7 @@ def prefit_note(res: pd.DataFrame) -> str:
     if not oneway.any() or not np.any(shift):
         return PREFIT_MEANING + "."
     return (f"{PREFIT_MEANING}; {ONE_WAY_PREFIT}: its a priori (zero) is no prediction, and against it every "
-            f"one-way row would read {significant(np.median(shift))} mm/s (−c × fitted offset) more.")
+            f"one-way row would be offset by {significant(np.median(shift))} mm/s (−c × the fitted offset).")
 
 
 def _rms(x) -> float:
