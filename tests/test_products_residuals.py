@@ -70,6 +70,14 @@ def test_report_tables_print_statistics_at_the_precision_they_carry(res):
         assert text.rstrip(".") in cells, (text, cells)
 
 
+def test_a_mean_that_rounds_to_zero_has_no_sign(res):
+    res, _, _ = res
+    used = (res["pass_id"] == 0) & (res["flags"] == 0) & (res["status"] == "")
+    res["postfit_los"] -= res.loc[used, "postfit_los"].mean() + 1e-7   # pass 0's mean: -0.0001 mm/s
+    (_, table, formats), = report_tables(statistics(res, by=("station_rx", "observable", "pass_id")))
+    assert re.findall(r"<td[^>]*>([^<]*)</td>", html_table(table, formats))[8] == "0.00"   # pass 0, post-fit mean
+
+
 @pytest.mark.parametrize("value, text", [(4516.098, "4520"), (0.52062, "0.521"), (12.0, "12.0"),
                                          (-0.0124, "-0.0124"), (0.999999, "1.00")])
 def test_significant_figures(value, text):
