@@ -5,8 +5,7 @@
 2. Write one run configuration per arc, as the ARTEMIS overlap studies cut them
    (seed 004 §4.5–4.6): short arcs of a few days between station-keeping
    maneuvers, and long arcs each spanning one station-keeping maneuver.
-3. Fit every arc with ``odpipe run`` on a local Dask cluster (resumable); the cluster starts, and its
-   workers import what an arc needs, while step 1 runs, and shuts down while step 4's report is written.
+3. Fit every arc with ``odpipe run`` on a local Dask cluster (resumable).
 4. Overlap precision (RIC, 3D RMS) of consecutive short and long arcs, the
    maneuver reconstruction (designed vs estimated station keeping, Table 4.4; estimated
    vs the executed truth), the truth comparison of every arc (actual errors against
@@ -24,7 +23,6 @@ sigma (100 km, 1 m/s, Table 4.1) makes the result independent of it.
 from __future__ import annotations
 
 import json
-from concurrent.futures import ThreadPoolExecutor
 from pathlib import Path
 
 import numpy as np
@@ -164,56 +162,28 @@ def run_demo(out: Path = Path("out/demo"), workers: int = 2, progress=print, day
              "executed": case_dir / "maneuvers_executed_truth.csv"}
     files.update({f"utdf:{n.station}": case_dir / f"{stem}_{n.station}.utdf" for n in case.networks
                   if n.format == "utdf"})
-    background = ThreadPoolExecutor(1)   # the cluster comes up while the case is simulated, and goes down
-    cluster = background.submit(_cluster, workers)   # while the report is written
-    try:
-        with compile_timer() as main_compile:
-            if not all(p.exists() for p in files.values()):
-                progress(f"simulating the case {case.name} into {case_dir} ...")
-                run_case(case, case_dir)
-            truth = SpkTrajectory(files["spk"], case.naif_id)
-            sigmas = data_sigmas(case)
-            arc_dir = out / "arcs"
-            arc_dir.mkdir(parents=True, exist_ok=True)
-            plan = arcs(float(utc_to_tdb(case.start)), float(utc_to_tdb(case.end)),
-                        list(np.asarray(utc_to_tdb(case.station_keeping_epochs()), float)))
-            configs = []
-            for name, _, a, b in plan:
-                path = arc_dir / f"{name}.toml"
-                text = arc_config(case, files, name, a, b, truth.state(a)[0] + OFFSET, sigmas)
-                if not path.exists() or path.read_text() != text:
-                    write_text(path, text)
-                configs.append(path)
-            progress(f"fitting {len(configs)} arcs on {workers} workers ...")
-            outcomes = run_batch(configs, _run_arc, scheduler=cluster.result().scheduler_address,
-                                 progress=progress)
-    finally:
-        closed = background.submit(lambda: cluster.result().close())
-        background.shutdown(wait=False)
+    with compile_timer() as main_compile:
+        if not all(p.exists() for p in files.values()):
+            progress(f"simulating the case {case.name} into {case_dir} ...")
+            run_case(case, case_dir)
+        truth = SpkTrajectory(files["spk"], case.naif_id)
+        sigmas = data_sigmas(case)
+        arc_dir = out / "arcs"
+        arc_dir.mkdir(parents=True, exist_ok=True)
+        plan = arcs(float(utc_to_tdb(case.start)), float(utc_to_tdb(case.end)),
+                    list(np.asarray(utc_to_tdb(case.station_keeping_epochs()), float)))
+        configs = []
+        for name, _, a, b in plan:
+            path = arc_dir / f"{name}.toml"
+            text = arc_config(case, files, name, a, b, truth.state(a)[0] + OFFSET, sigmas)
+            if not path.exists() or path.read_text() != text:
+                write_text(path, text)
+            configs.append(path)
+        progress(f"fitting {len(configs)} arcs on {workers} workers ...")
+        outcomes = run_batch(configs, _run_arc, workers=workers, progress=progress)
     progress(night_summary(outcomes))
     progress(compile_note(main_compile, outcomes))
-    headline = _report(out, case, plan, files, truth)
-    closed.result()
-    return headline
-
-
-def _cluster(workers: int):
-    """A local Dask cluster of ``workers`` single-threaded processes that have imported an arc's modules
-    (:func:`_imports`), as :func:`odpipe.operations.nightly.run_batch` would start it."""
-    from distributed import Client, LocalCluster
-
-    cluster = LocalCluster(n_workers=workers, threads_per_worker=1, processes=True, dashboard_address=":0")
-    with Client(cluster) as client:
-        client.run(_imports)
-    return cluster
-
-
-def _imports() -> None:
-    """What a worker's first arc would import: the run and the plots' matplotlib."""
-    import matplotlib.backends.backend_agg  # noqa: F401
-    import matplotlib.figure  # noqa: F401
-
-    import odpipe.pipeline.run  # noqa: F401
+    return _report(out, case, plan, files, truth)
 
 
 TRUTH_FORMATS = {"position error RMS (m)": "{:.3f}", "velocity error RMS (mm/s)": "{:.3f}",
