@@ -226,7 +226,7 @@ def plot_overlaps(summary: pd.DataFrame, path, kind: str = "pos", title: str = "
     ax.set_xticks(x, rows["overlap"], rotation=30, ha="right")
     ax.set_ylabel(f"RMS difference ({unit})")
     ax.set_xlabel("overlap (arc A − arc B)")
-    ax.set_title(title or ("Position" if kind == "pos" else "Velocity") + " overlap differences")
+    ax.set_title(title or ("Position" if kind == "pos" else "Velocity") + " overlap differences", y=1.0)
     ax.legend()
     ax.grid(axis="y", alpha=0.3)
     save_figure(path, fig, dpi=110)

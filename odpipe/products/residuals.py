@@ -207,7 +207,8 @@ def plot(res: pd.DataFrame, path, which: str = "postfit", title: str = "") -> No
     axes[-1].xaxis.set_major_locator(MultipleLocator(_tick_step_days(np.ptp(days))))
     axes[-1].xaxis.set_major_formatter(DateFormatter("%m-%d %H:%M"))
     axes[-1].set_xlabel("time (UTC)")
-    axes[0].set_title(title or f"{which.replace('fit', '-fit')} residuals along the line of sight")
+    # y given: the title sits on the axes' top without matplotlib laying out tick labels to look for some there
+    axes[0].set_title(title or f"{which.replace('fit', '-fit')} residuals along the line of sight", y=1.0)
     save_figure(path, fig, dpi=100)
 
 
