@@ -67,6 +67,8 @@ def test_bad_arcs_fail_alone_and_the_rest_run(tmp_path, capsys):
     assert lines[4] == f"report: {tmp_path / 'night' / 'report.html'}"
     assert "good.toml: skipped" in out.err and "chained.toml: failed" in out.err  # progress on stderr
     page = (tmp_path / "night" / "report.html").read_text()
+    assert "<title>odpipe batch nightly</title>" in page   # named by its configuration, nightly.toml
+    assert f"<td>{night}</td>" in page
     cells = [html.unescape(c) for c in re.findall(r"<td[^>]*>([^<]*)</td>", page)]
     assert "Failed arcs" in page and cells.count("bad.toml") == 1 and cells.count("absent.toml") == 1
     assert failed[str(arcs / "bad.toml")] in cells  # the whole message, as in the summary

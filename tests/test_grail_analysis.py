@@ -241,7 +241,7 @@ def test_rows_edited_before_the_fit_count_in_their_station_n_edited():
 
     res = pd.DataFrame({"station_rx": ["DSS-27"] * 3 + ["DSS-34"] * 3, "observable": "doppler_2way",
                         "pass_id": [1, 1, 1, 2, 2, 3], "status": "", "flags": [0, 256, 0, 0, 0, 0],
-                        "apriori_los": 1e-3, "postfit_los": 1e-4})
+                        "apriori_orbit_los": 1e-3, "postfit_los": 1e-4})
     before = pd.DataFrame({"station_rx": ["DSS-34"], "observable": ["doppler_2way"], "pass_id": [2]})
     stats = statistics(res).set_index("station_rx")["n_edited"]
     assert stats.to_dict() == {"DSS-27": 1, "DSS-34": 0}

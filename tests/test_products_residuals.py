@@ -3,11 +3,14 @@ the editing table that adds up with them."""
 
 from __future__ import annotations
 
+import re
+
 import numpy as np
 import pandas as pd
 import pytest
 
 from odpipe.preprocess.flags import Flag, summary
+from odpipe.operations.report import decimals, html_table, significant
 from odpipe.products.residuals import edit_summary, report_tables, statistics
 
 
@@ -19,7 +22,7 @@ def res():
     los = np.where(np.arange(n) < 200, 1e-3, 3e-3) * rng.standard_normal(n)
     out = pd.DataFrame({"station_rx": "DSS-24", "observable": "doppler_2way", "pass_id": np.arange(n) // 200,
                         "epoch": np.datetime64("2012-04-09T04:00", "ns") + np.arange(n) * np.timedelta64(60, "s"),
-                        "unit": "Hz", "postfit_los": los, "apriori_los": 2 * los, "postfit": los * hz_per_mps,
+                        "unit": "Hz", "postfit_los": los, "apriori_orbit_los": 2 * los, "postfit": los * hz_per_mps,
                         "flags": 0, "status": ""})
     out.loc[5, "flags"] = int(Flag.RESIDUAL)  # an edited row is counted, not used
     out.loc[7, "status"] = "no light-time solution"  # a row the models could not compute
@@ -50,6 +53,39 @@ def test_report_tables_show_mm_per_s_and_the_observed_unit(res):
                                    "end (UTC)", "pre-fit RMS (mm/s)", "post-fit mean (mm/s)", "post-fit RMS (mm/s)",
                                    "post-fit RMS (Hz)"]
     assert table["post-fit RMS (mm/s)"].iloc[1] == pytest.approx(np.sqrt(np.mean(los[200:] ** 2)) * 1e3, rel=1e-12)
+
+
+def test_report_tables_print_statistics_at_the_precision_they_carry(res):
+    """Each RMS to 3 significant figures; each post-fit mean to the first digit of the table's smallest
+    standard error: pass 0 holds 198 rows of 1 mm/s scatter (standard error 0.07 mm/s: 2 decimals)."""
+    res, los, _ = res
+    (_, table, formats), = report_tables(statistics(res, by=("station_rx", "observable", "pass_id")))
+    page = html_table(table, formats)
+    kept = np.delete(los[:200], [5, 7]) * 1e3   # mm/s
+    rms0, rms1 = np.sqrt(np.mean(kept ** 2)), np.sqrt(np.mean((los[200:] * 1e3) ** 2))
+    assert 0.05 < rms0 / np.sqrt(198) < 0.1 and rms1 / np.sqrt(200) > rms0 / np.sqrt(198)
+    cells = re.findall(r"<td>([^<]*)</td>", page)
+    for text in (f"{kept.mean():.2f}", f"{los[200:].mean() * 1e3:.2f}", f"{rms0:#.3g}", f"{2 * rms0:#.3g}",
+                 f"{rms1:#.3g}"):
+        assert text.rstrip(".") in cells, (text, cells)
+
+
+def test_a_mean_that_rounds_to_zero_has_no_sign(res):
+    res, _, _ = res
+    used = (res["pass_id"] == 0) & (res["flags"] == 0) & (res["status"] == "")
+    res["postfit_los"] -= res.loc[used, "postfit_los"].mean() + 1e-7   # pass 0's mean: -0.0001 mm/s
+    (_, table, formats), = report_tables(statistics(res, by=("station_rx", "observable", "pass_id")))
+    assert re.findall(r"<td[^>]*>([^<]*)</td>", html_table(table, formats))[8] == "0.00"   # pass 0, post-fit mean
+
+
+@pytest.mark.parametrize("value, text", [(4516.098, "4520"), (0.52062, "0.521"), (12.0, "12.0"),
+                                         (-0.0124, "-0.0124"), (0.999999, "1.00")])
+def test_significant_figures(value, text):
+    assert significant(value) == text
+
+
+def test_decimals_of_a_standard_error():
+    assert [decimals(x) for x in (0.13, 0.004, 25.0, 0.0, np.nan)] == [1, 3, 0, 0, 0]
 
 
 def test_edit_summary_adds_up_with_the_residual_tables(res):

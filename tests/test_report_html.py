@@ -6,8 +6,10 @@ every OEM epoch."""
 from __future__ import annotations
 
 import hashlib
+import html
 import json
 import re
+from dataclasses import replace
 from html.parser import HTMLParser
 from io import StringIO
 from pathlib import Path
@@ -18,11 +20,15 @@ import pandas as pd
 import pytest
 import spiceypy as sp
 
-from heo_case import simulate, write_config
+from heo_case import simulate, tdb, write_config
 from odpipe import __version__
 from odpipe.analysis import maneuvers as maneuver_report
 from odpipe.analysis.overlap import Overlap, report_tables as overlap_tables, summarize
+from odpipe.measurements import MeasurementSetup
 from odpipe.pipeline.run import run_config
+from odpipe.preprocess import store
+from odpipe.simulate.observe import simulate_tracking
+from odpipe.simulate.schedule import TrackingPlan
 from odpipe.operations.report import Section, render, utc_iso
 from parsers import oem
 
@@ -78,12 +84,27 @@ def test_the_rules_catch_what_the_old_reports_showed():
     assert len(broken_rules(old)) == 6
 
 
+F_ONE_WAY = 8.4e9            # Hz: an X-band oscillator
+Y0, Y1 = 1.5e-8, 1e-15        # its fractional offset (GRAIL-B's size, 4.5 m/s along the line of sight) and drift (1/s)
+
+
 @pytest.fixture(scope="module")
 def run(tmp_path_factory):
+    """The HEO arc's two-way Doppler and range, and one-way Doppler from an oscillator offset by ``Y0``
+    (drifting ``Y1``) that the fit estimates from a zero a priori."""
     tmp = tmp_path_factory.mktemp("report")
-    _, x_start = simulate(tmp, START, END)
-    write_config(tmp, "html_arc", START, END, x_start + np.r_[500.0, -400.0, 300.0, 0.004, -0.003, 0.002],
-                 "reweight = false")
+    truth, x_start = simulate(tmp, START, END)
+    plan = TrackingPlan(("DSS-14", "DSS-43", "DSS-63"), np.datetime64(START, "ns") + np.timedelta64(60, "s"),
+                        np.datetime64(END, "ns"), spacecraft="SC1", doppler="doppler_1way", uplink_hz=F_ONE_WAY)
+    clock = replace(MeasurementSetup.default(), oscillators={"SC1": (Y0, Y1, tdb(START))})
+    one_way, _ = simulate_tracking(truth, plan, clock, np.random.default_rng(11))
+    both = pd.concat([store.read(tmp / "tracking.parquet")[0], one_way[one_way["observable"] == "doppler_1way"]],
+                     ignore_index=True)
+    store.write(tmp / "tracking.parquet", both)
+    path = write_config(tmp, "html_arc", START, END, x_start + np.r_[500.0, -400.0, 300.0, 0.004, -0.003, 0.002],
+                        "reweight = false\noscillator_sigma = [1e-6, 1e-12]")
+    text = path.read_text().replace("doppler_2way = 1e-4 }", "doppler_2way = 1e-4, doppler_1way = 1e-4 }")
+    path.write_text(text.replace("[data]\n", '[data]\nobservables = ["doppler_2way", "range", "doppler_1way"]\n'))
     out = run_config(tmp / "arc.toml", progress=None)
     assert out["status"] == "complete"
     return tmp, Path(out["run"])
@@ -103,9 +124,11 @@ def test_night_report_keeps_the_rules(run):
     from odpipe.operations.nightly import ArcOutcome
 
     tmp, _ = run
-    page = night_report(tmp / "night", [tmp / "arc.toml"], [ArcOutcome(str(tmp / "arc.toml"), "complete", 1.0)])
+    page = night_report(tmp / "night", [tmp / "arc.toml"], [ArcOutcome(str(tmp / "arc.toml"), "complete", 1.0)],
+                        config=tmp / "grail_b_twoday.toml")
     text = page.read_text()
     assert broken_rules(text) == [] and "post-fit RMS (mm/s)" in text
+    assert "<title>odpipe batch grail_b_twoday</title>" in text and "Nightly" not in text
 
 
 def test_prefit_residuals_are_the_a_prioris_first_iteration(run):
@@ -120,6 +143,93 @@ def test_prefit_residuals_are_the_a_prioris_first_iteration(run):
     assert first["iteration"] == 1 and whitened == pytest.approx(first["prefit_rms"], rel=1e-6)
     stats = pd.read_csv(path / "residual_statistics.csv")
     assert (stats["prefit_rms"] > 10 * stats["postfit_rms"]).all()  # 500 m, 5 mm/s off a priori
+
+
+def _a_priori(tmp: Path):
+    """(run config, arc set-up, a priori reference) of the fixture's arc, built as the run builds them."""
+    from odpipe.od.arc import a_priori_reference
+    from odpipe.pipeline import setup as build
+    from odpipe.pipeline.config import load_config
+    from odpipe.pipeline.ingest import ingest
+
+    cfg = load_config(tmp / "arc.toml")
+    fm = build.force_model(cfg)
+    setup = build.arc_setup(cfg, fm, ingest(cfg.data.files, cfg.data.errors, cfg.arc.spacecraft).store,
+                            build.station_catalog(cfg))
+    return cfg, setup, a_priori_reference(setup, {})
+
+
+def test_one_way_prefit_is_the_a_priori_orbit_with_the_fitted_oscillator(run):
+    """The pre-fit one-way residuals (table, plot) are observed − computed by the measurement model on the
+    a priori orbit with the oscillator at its fitted offset and drift, to 2e-5 of c y0; against the
+    oscillator's zero a priori they would be offset by −c y0 (4.5 m/s), which the report states."""
+    from odpipe.constants import C_LIGHT
+    from odpipe.measurements import compute, residuals as observed_minus_computed
+    from odpipe.operations.report import significant
+
+    tmp, path = run
+    res = pd.read_parquet(path / "residuals.parquet")
+    params = pd.read_csv(path / "parameters.csv").set_index("name")["estimate"]
+    y0, y1 = params["SC1.osc_y0"], params["SC1.osc_y1"]
+    assert abs(y0 - Y0) < 1e-10   # the fit found the oscillator
+    _, setup, apriori = _a_priori(tmp)
+    used = res[(res["observable"] == "doppler_1way") & (res["status"] == "") & (res["flags"] == 0)]
+    rows = pd.read_parquet(path / "tracking.parquet").loc[used["row"]]
+    clock = replace(setup.measurements, oscillators={"SC1": (y0, y1, tdb(START))})
+    _, los = observed_minus_computed(rows, compute(rows, {"SC1": apriori}, clock))
+    assert np.max(np.abs(used["apriori_orbit_los"].to_numpy() - los)) < 2e-5 * C_LIGHT * abs(y0)
+    shift = np.median(used["apriori_los"] - used["apriori_orbit_los"]) * 1e3   # mm/s
+    assert abs(shift + C_LIGHT * y0 * 1e3) < C_LIGHT * abs(y1) * (tdb(END) - tdb(START)) * 1e3   # −c y0, and the drift
+    stats = pd.read_csv(path / "residual_statistics.csv")
+    one_way = stats[stats["observable"] == "doppler_1way"]
+    rms = [np.sqrt(np.mean(los[(used["station_rx"] == st).to_numpy()] ** 2)) for st in one_way["station_rx"]]
+    bound = 2e-5 * C_LIGHT * abs(y0)   # m/s: the model's and the report's rows agree to this
+    assert one_way["prefit_rms"].to_numpy() == pytest.approx(rms, abs=bound)
+    assert (one_way["prefit_rms"] < 0.01 * C_LIGHT * Y0).all()   # the oscillator's offset is not in it
+    page = (path / "report.html").read_text()
+    assert f"would be offset by {significant(shift)} mm/s" in html.unescape(page)
+    section = page.split("<h2>Residuals per station")[1].split("<h2>")[0]
+    assert "<h3>doppler_1way (observed in Hz)</h3>" in section   # the first of the tables (sorted by observable)
+    shown = pd.read_html(StringIO(section))[0]
+    assert shown["station_rx"].tolist() == one_way["station_rx"].tolist()
+    assert shown["pre-fit RMS (mm/s)"].to_numpy() == pytest.approx(np.array(rms) * 1e3, abs=(bound + 0.005 * max(rms)) * 1e3)
+
+
+def test_headline_and_tables_carry_three_significant_figures(run):
+    """The headline post-fit RMS and the tables' RMS are the statistics (full precision in the CSV) to 3
+    significant figures."""
+    from odpipe.operations.report import significant
+
+    _, path = run
+    page = html.unescape((path / "report.html").read_text())
+    stats = pd.read_csv(path / "residual_statistics.csv")
+    for row in stats.itertuples():
+        scale, unit = (1e3, "mm/s") if row.observable.startswith("doppler") else (1.0, "m")
+        cell = re.search(rf"postfit RMS {row.observable} {row.station_rx} \({unit}\)</td><td>([^<]*)<", page)
+        assert float(cell.group(1)) == float(significant(row.postfit_rms * scale))
+        assert f"<td>{significant(row.prefit_rms * scale)}</td>" in page
+        assert f"<td>{significant(row.postfit_rms * scale)}</td>" in page
+
+
+def test_a_priori_reference_covers_a_first_window_opening_before_the_arc(run):
+    """An arc's first count window may open before the arc's start (GRAIL-B 04-11, DSS-54's first one-way
+    window): the a priori reference spans its look-back, so the geometry of those samples is there, as from
+    the a priori state propagated back on its own."""
+    from odpipe.dynamics.propagator import propagate
+    from odpipe.pipeline.geometry import add_geometry
+
+    tmp, _ = run
+    cfg, setup, apriori = _a_priori(tmp)
+    t = tdb(START)
+    assert apriori.t0 == t - setup.lookback
+    back = propagate(setup.state0, t, t - setup.lookback, setup.force_model, with_stm=False)
+    rows = pd.DataFrame({"epoch": np.datetime64(START, "ns") - np.array([30, 5], "timedelta64[s]"),
+                         "station_rx": "DSS-14"})
+    catalog = setup.measurements.stations
+    ours = add_geometry(rows, apriori, setup.force_model.ephemeris, catalog)
+    alone = add_geometry(rows, back, setup.force_model.ephemeris, catalog)
+    assert np.isfinite(ours["elevation_rx"]).all()
+    assert np.max(np.abs(ours["elevation_rx"] - alone["elevation_rx"])) < 1e-9   # rad
 
 
 def test_editing_table_agrees_with_the_residual_tables(run):

@@ -205,10 +205,10 @@ def long_arc_schedule(maneuvers_tdb, margin_s: float = 3600.0):
 
 
 def plot_overlaps(summary: pd.DataFrame, path, kind: str = "pos", title: str = "") -> None:
-    """Bar chart per overlap of the R, I, C and 3D RMS differences (thesis Figs. 4.10–4.13)."""
-    import matplotlib
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
+    """Bar chart per overlap of the R, I, C and 3D RMS differences (thesis Figs. 4.10–4.13), on a bare Agg
+    figure (no pyplot; fixed margins instead of a tight layout's extra draw)."""
+    from matplotlib.backends.backend_agg import FigureCanvasAgg
+    from matplotlib.figure import Figure
 
     from parsers.atomic import save_figure
 
@@ -217,15 +217,16 @@ def plot_overlaps(summary: pd.DataFrame, path, kind: str = "pos", title: str = "
     cols = [f"{kind}_{c}_rms" for c in COMPONENTS] + [f"{kind}_3d_rms"]
     scale, unit = (1.0, "m") if kind == "pos" else (1e3, "mm/s")
     x = np.arange(len(rows))
-    fig, ax = plt.subplots(figsize=(8, 4))
+    fig = Figure(figsize=(8, 4))
+    FigureCanvasAgg(fig)
+    fig.subplots_adjust(left=0.1, right=0.98, top=0.92, bottom=0.3)
+    ax = fig.subplots()
     for k, (label, col) in enumerate(zip(labels, cols)):
         ax.bar(x + (k - 1.5) * 0.2, rows[col] * scale, width=0.2, label=label)
     ax.set_xticks(x, rows["overlap"], rotation=30, ha="right")
     ax.set_ylabel(f"RMS difference ({unit})")
     ax.set_xlabel("overlap (arc A − arc B)")
-    ax.set_title(title or ("Position" if kind == "pos" else "Velocity") + " overlap differences")
+    ax.set_title(title or ("Position" if kind == "pos" else "Velocity") + " overlap differences", y=1.0)
     ax.legend()
     ax.grid(axis="y", alpha=0.3)
-    fig.tight_layout()
     save_figure(path, fig, dpi=110)
-    plt.close(fig)

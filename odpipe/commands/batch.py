@@ -58,9 +58,10 @@ def starts_from(arcs: list[Path], cfgs: dict | None = None, broken=()) -> dict:
     return after
 
 
-def night_report(out: Path, arcs: list[Path], outcomes, overlap_arcs: list[Path] | None = None) -> Path:
-    """The night's report in ``out``: residual statistics per arc and station, overlaps of consecutive
-    arcs among ``overlap_arcs`` (default all)."""
+def night_report(out: Path, arcs: list[Path], outcomes, overlap_arcs: list[Path] | None = None,
+                 config: Path | None = None) -> Path:
+    """The batch's report in ``out``: residual statistics per arc and station, overlaps of consecutive
+    arcs among ``overlap_arcs`` (default all); titled by the batch configuration ``config`` (its name)."""
     import pandas as pd
 
     from odpipe.analysis.overlap import consecutive_overlaps, oem_trajectory, report_tables
@@ -83,13 +84,16 @@ def night_report(out: Path, arcs: list[Path], outcomes, overlap_arcs: list[Path]
     stats = pd.concat([pd.read_csv(run / "residual_statistics.csv").assign(arc=name) for _, name, run, _ in done],
                       ignore_index=True) if done else pd.DataFrame()
     headline = {"arcs": night_summary(outcomes).splitlines()[0]}
+    if config is not None:
+        headline["batch configuration"] = str(Path(config).resolve())
     sections = []
     if not stats.empty:
         stats = stats[["arc"] + [c for c in stats.columns if c != "arc"]]
         write_csv(out / "residual_statistics.csv", stats, index=False)
         sections.append(Section("Post-fit residuals per arc and station").text(
             "Along the line of sight (Doppler mm/s, range m), and the post-fit RMS in the observable's unit; "
-            "per pass in each run's residual_statistics_passes.csv").tables(residuals.report_tables(stats)))
+            "per pass in each run's residual_statistics_passes.csv. "
+            f"{residuals.PREFIT_MEANING}, {residuals.ONE_WAY_PREFIT}.").tables(residuals.report_tables(stats)))
     seq = [(name, run) for _, name, run, a in done if overlap_arcs is None or a in overlap_arcs]
     table, pngs = consecutive_overlaps({name: oem_trajectory(run / "trajectory.oem") for name, run in seq},
                                        [name for name, _ in seq], out, "arcs", "Consecutive-arc", step=60.0)
@@ -105,7 +109,8 @@ def night_report(out: Path, arcs: list[Path], outcomes, overlap_arcs: list[Path]
     if failed:
         sections.append(Section("Failed arcs").table(pd.DataFrame(
             [{"arc": Path(o.config).name, "error": o.error} for o in failed])))
-    return write_report(out / "report.html", "Nightly batch", headline, sections)
+    title = "odpipe batch" + (f" {Path(config).stem}" if config is not None else "")
+    return write_report(out / "report.html", title, headline, sections)
 
 
 def _arc(path: Path) -> dict:
@@ -131,5 +136,5 @@ def run(args) -> int:
                          warm=warm_worker)
     print(night_summary(outcomes))
     if batch.report is not None:
-        print(f"report: {night_report(batch.report, arcs, outcomes, overlap_arcs)}")
+        print(f"report: {night_report(batch.report, arcs, outcomes, overlap_arcs, args.config)}")
     return Exit.PARTIAL if any(o.status == "failed" for o in outcomes) else Exit.OK

@@ -325,7 +325,7 @@ def _bias_apriori(setup: ArcSetup, observable: str, station) -> float:
 
 class ReferenceChain:
     """One spacecraft's reference over ``[t0, t1]`` (TDB s) from consecutive segments: ``state(t)`` (N, 6)
-    m, m/s relative to ``center``, from the segment whose span holds ``t`` (before ``t0``: the first
+    m, m/s relative to ``center``, from the segment whose span holds ``t`` (before its start: the first
     one's look-back); ``n_eval`` force evaluations."""
 
     def __init__(self, starts, trajectories, t0: float, t1: float):
@@ -363,7 +363,8 @@ def a_priori_reference(setup: ArcSetup, shared: dict) -> ReferenceChain:
         trajs.append(seg.trajs[setup.spacecraft])
         x, _ = problem.transition(t, seg.b, x)
         t = seg.b
-    return ReferenceChain(starts, trajs, setup.start, setup.end)
+    # its span starts with the first segment's look-back: an arc's first count window may open before the arc
+    return ReferenceChain(starts, trajs, setup.start - setup.lookback, setup.end)
 
 
 def fit_arc(table: pd.DataFrame, setup: ArcSetup, shared: dict | None = None) -> ArcSolution:

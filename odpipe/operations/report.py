@@ -54,6 +54,19 @@ def _round(t: np.ndarray, unit: str) -> np.ndarray:
     return (((ns + step // 2) // step) * step).astype("datetime64[ns]")
 
 
+def significant(value: float, digits: int = 3) -> str:
+    """``value`` to ``digits`` significant figures in positional notation, trailing zeros kept
+    (4516.098 → "4520", 0.52062 → "0.521", 12 → "12.0"): a statistic at the precision it carries."""
+    return np.format_float_positional(float(value), precision=digits, unique=False, fractional=False,
+                                      trim="k").rstrip(".")
+
+
+def decimals(step: float) -> int:
+    """Decimals that show a quantity to its first significant digit of ``step`` (e.g. a standard error):
+    0.13 → 1, 0.004 → 3, 25 → 0."""
+    return max(0, -int(np.floor(np.log10(step)))) if np.isfinite(step) and step > 0 else 0
+
+
 def _cell(value, fmt) -> str:
     if value is None or (np.ndim(value) == 0 and not isinstance(value, str) and pd.isna(value)):
         return MISSING

@@ -45,7 +45,7 @@ from odpipe.products.oem import write_oem
 from odpipe.products.spk import write_spk
 from odpipe.operations import rundir
 from odpipe.operations.schema import ConfigError
-from odpipe.operations.report import Section, write_report
+from odpipe.operations.report import Section, significant, write_report
 from odpipe.time import tdb_to_utc
 from odpipe.tracking import ramp_segments
 from parsers.ionex import read_ionex
@@ -234,6 +234,7 @@ def unlogged_maneuvers(res: pd.DataFrame, window: int = 20, p_false: float = 1e-
 def _products(cfg, attempt, log, table, arc, edits, fit_seconds, findings, fingerprint, ramps=None,
               before=None) -> dict:
     res = arc.residuals
+    res["apriori_orbit_los"] = residuals.apriori_orbit_los(arc)
     stats = residuals.statistics(res, edited_before=before)
     write_parquet(attempt.product("tracking.parquet"), table)
     write_parquet(attempt.product("residuals.parquet"), res)
@@ -260,7 +261,7 @@ def _products(cfg, attempt, log, table, arc, edits, fit_seconds, findings, finge
         write_spk(attempt.product("trajectory.bsp"), segments, cfg.products.naif_id, comments=prov)
     figures = []
     if cfg.products.plots:
-        for which, caption in (("prefit", "pre-fit residuals against the a priori (first iteration)"),
+        for which, caption in (("prefit", "pre-fit residuals (on the a priori orbit)"),
                                ("postfit", "post-fit residuals")):
             png = attempt.product(f"residuals_{which}.png")
             residuals.plot(res, png, which, f"{cfg.run.name}: {caption}")
@@ -287,9 +288,10 @@ def provenance(cfg, fingerprint: dict, what: str) -> list[str]:
 def _sections(cfg, res, stats, per_pass, diag, edits, params, figures, findings, man_rows, man_stats,
               man_epochs) -> list[Section]:
     resid = Section("Residuals per station").text(
-        "Along the line of sight: Doppler in mm/s, range in m; the pre-fit residuals are against the a priori "
-        "(the fit's first iteration), the post-fit against the smoothed solution; the last column is the "
-        "post-fit RMS in the observable's own unit.").tables(residuals.report_tables(stats))
+        "Along the line of sight: Doppler in mm/s, range in m. " + residuals.prefit_note(res) + " Post-fit: "
+        "against the smoothed solution; the last column is the post-fit RMS in the observable's own unit. "
+        "Each RMS to 3 significant figures, each mean to the first digit of its standard error "
+        "(RMS/√n).").tables(residuals.report_tables(stats))
     for png, caption in figures:
         resid.figure(png, caption)
     sections = [resid, Section("Residuals per pass").tables(residuals.report_tables(per_pass)),
@@ -328,14 +330,19 @@ def _headline(summary: dict) -> dict:
     return out
 
 
+def _three(x) -> float:
+    """An RMS or sigma to the 3 significant figures it carries (:func:`odpipe.operations.report.significant`)."""
+    return float(significant(x))
+
+
 def _summary(cfg, arc, stats, fit_seconds) -> dict:
     out = {"arc": cfg.run.name, "spacecraft": cfg.arc.spacecraft, "start": cfg.arc.start, "end": cfg.arc.end,
            "converged": bool(arc.converged), "iterations": len(arc.history),
            "iterations_per_fit": iteration_stages(arc.history), "fit_seconds": round(fit_seconds, 2)}
     for row in stats.itertuples(index=False):
         scale, unit = residuals.display_scale(row.observable)
-        out[f"postfit RMS {row.observable} {row.station_rx} ({unit})"] = round(row.postfit_rms * scale, 5)
+        out[f"postfit RMS {row.observable} {row.station_rx} ({unit})"] = _three(row.postfit_rms * scale)
     sig = arc.covariances[0]
-    out["epoch position sigma (m)"] = round(float(np.sqrt(np.trace(sig[:3, :3]))), 3)
-    out["epoch velocity sigma (mm/s)"] = round(float(np.sqrt(np.trace(sig[3:, 3:]))) * 1e3, 4)
+    out["epoch position sigma (m)"] = _three(np.sqrt(np.trace(sig[:3, :3])))
+    out["epoch velocity sigma (mm/s)"] = _three(np.sqrt(np.trace(sig[3:, 3:])) * 1e3)
     return out

@@ -1,10 +1,10 @@
 """Residual products: statistics per station, observable and pass, and plots in physical units.
 
 Works on a fit's residual table (columns ``epoch``, ``observable``,
-``station_rx``, ``pass_id``, ``unit``, ``apriori_los`` (pre-fit, against the
-a priori), ``postfit_los`` in m or m/s along the line of sight, ``postfit`` in
-the row's unit, ``flags``, ``status``). Rate observables are shown in mm/s,
-range observables in m.
+``station_rx``, ``pass_id``, ``unit``, ``apriori_orbit_los`` (pre-fit: on the
+a priori orbit, see :func:`apriori_orbit_los`), ``postfit_los`` in m or m/s
+along the line of sight, ``postfit`` in the row's unit, ``flags``, ``status``).
+Rate observables are shown in mm/s, range observables in m.
 """
 
 from __future__ import annotations
@@ -12,6 +12,8 @@ from __future__ import annotations
 import numpy as np
 import pandas as pd
 
+from odpipe.constants import C_LIGHT
+from odpipe.operations.report import decimals, significant
 from parsers.atomic import save_figure
 
 _RATE = ("doppler", "range_rate", "sst_doppler")
@@ -26,6 +28,48 @@ def display_scale(observable: str) -> tuple[float, str]:
     return (1e3, "mm/s") if is_rate(observable) else (1.0, "m")
 
 
+PREFIT_MEANING = ("Pre-fit: observed − computed on the a priori orbit (the arc's a priori state and force "
+                  "parameters, the fit's first reference)")
+ONE_WAY_PREFIT = "the one-way Doppler with its oscillator at the fitted offset and drift"
+
+
+def apriori_orbit_los(arc) -> np.ndarray:
+    """Pre-fit residuals of an arc fit (an :class:`odpipe.od.arc.ArcSolution`) along the line of sight (m,
+    m/s): observed − computed on the a priori orbit (``apriori_los``) with the one-way oscillator at its
+    fitted offset and drift, ``apriori_los + c (Δy0 + Δy1 (t − t_ref))`` on ``doppler_1way`` rows (Δ: fitted −
+    a priori; t the row's TDB time). The oscillator's a priori (0 ± 1e-6 when unknown) is no prediction:
+    against it every one-way row reads −c y0, 4.5 m/s for GRAIL-B's 1.5e-8. A fractional offset y lowers
+    the one-way Doppler along the line of sight by c y (1 − proper) span/Tc
+    (:func:`odpipe.measurements.dsn.one_way_doppler`): c y to |range rate|/c + |proper| ≲ 1e-5 of itself."""
+    res = arc.residuals
+    out = res["apriori_los"].to_numpy(float).copy()
+    oneway = res["observable"].astype(str).eq("doppler_1way").to_numpy()
+    est = arc.parameters["estimate"].to_numpy(float)
+    clocks = {p.info.get("oscillator"): i for i, p in enumerate(arc.registry.parameters)
+              if p.kind == "clock" and p.owner == arc.spacecraft}
+    if not clocks or not oneway.any():
+        return out
+    t_ref = arc.problem.setup.oscillators[arc.spacecraft][2]
+    dy = np.zeros(len(res))
+    if "y0" in clocks:
+        dy += est[clocks["y0"]] - arc.registry.apriori[clocks["y0"]]
+    if "y1" in clocks:
+        dy += (est[clocks["y1"]] - arc.registry.apriori[clocks["y1"]]) * (res["time"].to_numpy(float) - t_ref)
+    out[oneway] += C_LIGHT * dy[oneway]
+    return out
+
+
+def prefit_note(res: pd.DataFrame) -> str:
+    """What the pre-fit residuals of a run's table are (a sentence for the report), with the one-way
+    oscillator's share when it was fitted: the median of ``apriori_los − apriori_orbit_los`` (mm/s)."""
+    oneway = res["observable"].astype(str).eq("doppler_1way") & res["status"].eq("")
+    shift = (res.loc[oneway, "apriori_los"] - res.loc[oneway, "apriori_orbit_los"]).to_numpy(float) * 1e3
+    if not oneway.any() or not np.any(shift):
+        return PREFIT_MEANING + "."
+    return (f"{PREFIT_MEANING}; {ONE_WAY_PREFIT}: its a priori (zero) is no prediction, and against it every "
+            f"one-way row would be offset by {significant(np.median(shift))} mm/s (−c × the fitted offset).")
+
+
 def _rms(x) -> float:
     return float(np.sqrt(np.mean(np.square(x))))
 
@@ -37,7 +81,7 @@ def statistics(res: pd.DataFrame, by=("station_rx", "observable"), edited_before
     """Per group: rows fitted (``n_used``), edited by the fit or, the tracking rows ``edited_before`` (e.g. the
     a priori blunder test's), before it (``n_edited``) and not computable by the
     models (``n_failed``); first and last epoch (UTC) of the used rows; mean and RMS of the post-fit and
-    RMS of the pre-fit residual against the a priori (``apriori_los``, the first iteration's), all
+    RMS of the pre-fit residual (``apriori_orbit_los``, :func:`apriori_orbit_los`), all
     along the line of sight in ``los_unit`` (m or m/s); and the post-fit RMS in the observable's own
     unit (``postfit_rms_obs`` in ``obs_unit``, e.g. Hz, RU) when the residuals carry ``unit``."""
     by = list(by)
@@ -51,7 +95,7 @@ def statistics(res: pd.DataFrame, by=("station_rx", "observable"), edited_before
     out["n_failed"] = _count(res[~ok], by, out.index)
     if "epoch" in used:
         out["start"], out["end"] = g["epoch"].min(), g["epoch"].max()
-    out["prefit_rms"] = g["apriori_los"].apply(_rms)
+    out["prefit_rms"] = g["apriori_orbit_los"].apply(_rms)
     out["postfit_mean"] = g["postfit_los"].mean()
     out["postfit_rms"] = g["postfit_los"].apply(_rms)
     out = out.reset_index()
@@ -70,9 +114,10 @@ def _count(rows: pd.DataFrame, by: list, index) -> np.ndarray:
 
 def report_tables(stats: pd.DataFrame) -> list[tuple[str, pd.DataFrame, dict]]:
     """(caption, table, formats) per observable and unit of a :func:`statistics` table for a report:
-    residuals in the display unit (:func:`display_scale`) to 0.1 µm/s or 1 mm, in the observable's unit
-    to 4 significant figures, the unit in each column name. Columns before ``n_used`` (e.g. arc,
-    station, pass) lead."""
+    residuals in the display unit (:func:`display_scale`) and in the observable's unit, the unit in each
+    column name; each RMS to 3 significant figures (an RMS of n rows is known to 1/√(2n): 9 % for 60),
+    the post-fit mean to the first digit of its smallest standard error (RMS/√n) in the table. Columns
+    before ``n_used`` (e.g. arc, station, pass) lead."""
     keys = [c for c in stats.columns[: list(stats.columns).index("n_used")] if c != "observable"]
     out = []
     for (obs, unit), sub in stats.groupby(["observable", stats.get("obs_unit", pd.Series("", index=stats.index))],
@@ -87,9 +132,9 @@ def report_tables(stats: pd.DataFrame) -> list[tuple[str, pd.DataFrame, dict]]:
         t[f"post-fit RMS ({shown})"] = sub["postfit_rms"] * scale
         if unit:
             t[f"post-fit RMS ({unit})"] = sub["postfit_rms_obs"]
-        fmt = {c: ("{:.4f}" if shown == "mm/s" else "{:.3f}") for c in t.columns if f"({shown})" in c}
-        if unit:
-            fmt[f"post-fit RMS ({unit})"] = "{:.4g}"
+        fmt = {c: significant for c in t.columns if "RMS" in c}
+        places = decimals(np.min(sub["postfit_rms"] / np.sqrt(sub["n_used"])) * scale)  # the mean's standard error
+        fmt[f"post-fit mean ({shown})"] = lambda v, p=places: f"{round(v, p) + 0.0:.{p}f}"   # + 0.0: no "-0.00"
         out.append((f"{obs}" + (f" (observed in {unit})" if unit else ""), t, fmt))
     return out
 
@@ -113,39 +158,64 @@ def edit_summary(preprocess: pd.DataFrame, res: pd.DataFrame) -> pd.DataFrame:
                         columns=["stage", "reason", "rows"])
 
 
-COLUMN = {"prefit": "apriori_los", "postfit": "postfit_los"}  # pre-fit: against the a priori
+COLUMN = {"prefit": "apriori_orbit_los", "postfit": "postfit_los"}  # pre-fit: see apriori_orbit_los
 
 
 def plot(res: pd.DataFrame, path, which: str = "postfit", title: str = "") -> None:
-    """One panel per observable of the ``which`` ("prefit": against the a priori, or "postfit")
-    residuals, stations coloured; edited rows drawn as grey crosses; time axis UTC."""
-    import matplotlib
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
+    """One panel per observable of the ``which`` ("prefit": :func:`apriori_orbit_los`, or "postfit")
+    residuals, stations coloured; edited rows drawn as grey crosses; time axis UTC.
+
+    Drawn on a bare Agg figure (no pyplot, no tight layout: fixed margins, one draw per PNG), one marker
+    line per station and one for the edited rows."""
+    from matplotlib.backends.backend_agg import FigureCanvasAgg
+    from matplotlib.dates import DateFormatter, date2num
+    from matplotlib.figure import Figure
+    from matplotlib.ticker import MultipleLocator
 
     ok = res["status"].eq("") if "status" in res else pd.Series(True, index=res.index)
     res = res[ok]
     observables = sorted(res["observable"].unique())
-    fig, axes = plt.subplots(len(observables), 1, figsize=(10, 2.8 * max(len(observables), 1)), squeeze=False)
-    for ax, obs in zip(axes[:, 0], observables):
+    n = max(len(observables), 1)
+    height = 2.8 * n
+    fig = Figure(figsize=(10, height))
+    FigureCanvasAgg(fig)
+    fig.subplots_adjust(left=0.09, right=0.98, top=1 - 0.35 / height, bottom=0.75 / height, hspace=0.12)
+    axes = fig.subplots(n, 1, sharex=True, squeeze=False)[:, 0]
+    for ax, obs in zip(axes, observables):
         scale, unit = display_scale(obs)
         sub = res[res["observable"] == obs]
-        edited = sub["flags"] != 0
-        for station, g in sub[~edited].groupby("station_rx"):
-            y = g[COLUMN[which]] * scale
-            ax.plot(g["epoch"], y, ".", ms=3, label=f"{station} (RMS {np.sqrt(np.mean(y**2)):.3g} {unit})")
+        edited = (sub["flags"] != 0).to_numpy()
+        y_all = sub[COLUMN[which]].to_numpy(float) * scale
+        t_all = date2num(sub["epoch"].to_numpy("datetime64[ns]"))  # days: no unit conversion at each draw
+        stations = sub["station_rx"].astype(str).to_numpy()
+        for station in sorted(set(stations[~edited])):
+            sel = ~edited & (stations == station)
+            y = y_all[sel]
+            ax.plot(t_all[sel], y, ".", ms=3,
+                    label=f"{station} (RMS {significant(np.sqrt(np.mean(y**2)))} {unit})")
         if edited.any():
-            ax.plot(sub.loc[edited, "epoch"], sub.loc[edited, COLUMN[which]] * scale, "x", color="0.6", ms=3,
+            ax.plot(t_all[edited], y_all[edited], "x", color="0.6", ms=3,
                     label=f"edited ({int(edited.sum())})")
-            lim = np.nanpercentile(np.abs(sub.loc[~edited, COLUMN[which]] * scale), 99.9) * 3 if (~edited).any() else None
-            if lim:
-                ax.set_ylim(-lim, lim)
+            if (~edited).any():
+                lim = np.nanpercentile(np.abs(y_all[~edited]), 99.9) * 3
+                if lim:
+                    ax.set_ylim(-lim, lim)
         ax.set_ylabel(f"{obs} ({unit})")
         ax.grid(alpha=0.3)
         ax.legend(fontsize=7, loc="upper right", ncol=2)
-    axes[-1, 0].set_xlabel("time (UTC)")
-    axes[0, 0].set_title(title or f"{which.replace('fit', '-fit')} residuals along the line of sight")
-    fig.autofmt_xdate()
-    fig.tight_layout()
+    days = date2num(res["epoch"].to_numpy("datetime64[ns]")) if len(res) else np.zeros(1)
+    axes[-1].xaxis.set_major_locator(MultipleLocator(_tick_step_days(np.ptp(days))))
+    axes[-1].xaxis.set_major_formatter(DateFormatter("%m-%d %H:%M"))
+    axes[-1].set_xlabel("time (UTC)")
+    # y given: the title sits on the axes' top without matplotlib laying out tick labels to look for some there
+    axes[0].set_title(title or f"{which.replace('fit', '-fit')} residuals along the line of sight", y=1.0)
     save_figure(path, fig, dpi=100)
-    plt.close(fig)
+
+
+TICK_STEPS_H = (1, 2, 3, 6, 12, 24, 48, 96, 168)  # h: whole UTC hours and days
+
+
+def _tick_step_days(span_days: float, most: int = 9) -> float:
+    """The shortest of :data:`TICK_STEPS_H` (in days) that puts at most ``most`` ticks on ``span_days``: a
+    fixed step instead of matplotlib's date locator, which searches its intervals at every draw."""
+    return next((h / 24 for h in TICK_STEPS_H if span_days / (h / 24) <= most - 1), TICK_STEPS_H[-1] / 24)
