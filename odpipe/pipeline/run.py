@@ -234,7 +234,7 @@ def unlogged_maneuvers(res: pd.DataFrame, window: int = 20, p_false: float = 1e-
 def _products(cfg, attempt, log, table, arc, edits, fit_seconds, findings, fingerprint, ramps=None,
               before=None) -> dict:
     res = arc.residuals
-    res["apriori_orbit_los"] = residuals.apriori_orbit_los(arc)
+    res["apriori_orbit_los"] = residuals.apriori_orbit_los(arc, table)
     stats = residuals.statistics(res, edited_before=before)
     write_parquet(attempt.product("tracking.parquet"), table)
     write_parquet(attempt.product("residuals.parquet"), res)

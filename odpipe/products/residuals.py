@@ -13,6 +13,7 @@ import numpy as np
 import pandas as pd
 
 from odpipe.constants import C_LIGHT
+from odpipe.measurements import oscillators
 from odpipe.operations.report import decimals, significant
 from parsers.atomic import save_figure
 
@@ -33,29 +34,36 @@ PREFIT_MEANING = ("Pre-fit: observed − computed on the a priori orbit (the arc
 ONE_WAY_PREFIT = "the one-way Doppler with its oscillator at the fitted offset and drift"
 
 
-def apriori_orbit_los(arc) -> np.ndarray:
+def apriori_orbit_los(arc, table: pd.DataFrame) -> np.ndarray:
     """Pre-fit residuals of an arc fit (an :class:`odpipe.od.arc.ArcSolution`) along the line of sight (m,
     m/s): observed − computed on the a priori orbit (``apriori_los``) with the one-way oscillator at its
     fitted offset and drift, ``apriori_los + c (Δy0 + Δy1 (t − t_ref))`` on ``doppler_1way`` rows (Δ: fitted −
-    a priori; t the row's TDB time). The oscillator's a priori (0 ± 1e-6 when unknown) is no prediction:
+    a priori of the row's own oscillator, :mod:`odpipe.measurements.oscillators`, found from the tracking
+    ``table`` row's band and pass; t the row's TDB time). The oscillator's a priori (0 ± 1e-6 when unknown) is no prediction:
     against it every one-way row reads −c y0, 4.5 m/s for GRAIL-B's 1.5e-8. A fractional offset y lowers
     the one-way Doppler along the line of sight by c y (1 − proper) span/Tc
     (:func:`odpipe.measurements.dsn.one_way_doppler`): c y to |range rate|/c + |proper| ≲ 1e-5 of itself."""
     res = arc.residuals
     out = res["apriori_los"].to_numpy(float).copy()
     oneway = res["observable"].astype(str).eq("doppler_1way").to_numpy()
-    est = arc.parameters["estimate"].to_numpy(float)
-    clocks = {p.info.get("oscillator"): i for i, p in enumerate(arc.registry.parameters)
-              if p.kind == "clock" and p.owner == arc.spacecraft}
-    if not clocks or not oneway.any():
+    est, apriori = arc.parameters["estimate"].to_numpy(float), arc.registry.apriori
+    fitted = {}   # oscillator name -> [Δy0, Δy1, t_ref]
+    for i, p in enumerate(arc.registry.parameters):
+        if p.kind == "clock" and "oscillator" in p.info:
+            terms = fitted.setdefault(p.owner, [0.0, 0.0, p.info["t_ref"]])
+            terms[("y0", "y1").index(p.info["oscillator"])] = est[i] - apriori[i]
+    if not fitted or not oneway.any():
         return out
-    t_ref = arc.problem.setup.oscillators[arc.spacecraft][2]
-    dy = np.zeros(len(res))
-    if "y0" in clocks:
-        dy += est[clocks["y0"]] - arc.registry.apriori[clocks["y0"]]
-    if "y1" in clocks:
-        dy += (est[clocks["y1"]] - arc.registry.apriori[clocks["y1"]]) * (res["time"].to_numpy(float) - t_ref)
-    out[oneway] += C_LIGHT * dy[oneway]
+    rows = res.loc[oneway]
+    bands = table.loc[rows["row"].to_numpy(), "band_down"].to_numpy()
+    names = oscillators.row_names(arc.spacecraft, rows.assign(band_down=bands), fitted)
+    t = rows["time"].to_numpy(float)
+    dy = np.zeros(len(rows))
+    for osc in set(names) & set(fitted):
+        dy0, dy1, t_ref = fitted[osc]
+        at = names == osc
+        dy[at] = dy0 + dy1 * (t[at] - t_ref)
+    out[oneway] += C_LIGHT * dy
     return out
 
 
