@@ -227,3 +227,18 @@ def test_span_answers_every_interval_as_predict_and_transition_do(case):
     r = slice(bounds[k] - bounds[0], bounds[k + 1] - bounds[0])
     assert _normalized_error(computed[r], c_ta) < 1e-14
     assert _normalized_error(H[r], H_ta) < 1e-12
+
+
+def test_span_over_a_segment_without_rows_gives_its_transitions(case):
+    """A segment holding no rows (an arc whose first data come after a burn, or whose a priori reference starts
+    before the first count): ``span`` flies it and answers with no rows, its transitions those of ``transition``."""
+    sc, reg, setup = case["sc"], case["reg"], case["setup"]
+    later = case["times"] >= sc["t_man"]
+    rows, times = case["rows"][later], case["times"][later]
+    prob = TrackingProblem(reg, rows, times, {"SC": force_model()}, setup.measurements, sc["t0"], sc["t1"])
+    epochs = np.arange(sc["t0"], sc["t_man"] + 1.0, 3600.0)
+    refs, Phi, computed, H = prob.span(epochs, reg.apriori, np.zeros(epochs.size, int))
+    assert computed.shape == (0,) and H.shape == (0, len(reg))
+    x1, Phi_1 = prob.transition(epochs[0], epochs[1], reg.apriori)
+    np.testing.assert_array_equal(refs[1], x1)
+    assert _normalized_error(Phi[0], Phi_1) < 1e-14

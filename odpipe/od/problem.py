@@ -304,9 +304,10 @@ class TrackingProblem:
 
     def _evaluate(self, lo, hi, trajs, x0):
         n, m = len(self.registry), hi - lo
-        G_x, G_p = {}, {}
+        G_x = {sc: np.zeros((m, 6)) for sc in trajs}
+        G_p = {sc: np.zeros((m, len(trajs[sc].param_names))) for sc in trajs}
         H_lin = np.zeros((m, n))
-        if m == 0:
+        if m == 0:   # a segment without rows (span still reads its partials)
             return np.zeros(0), np.zeros(0), np.zeros(0, object), G_x, G_p, H_lin
         if (lo, hi) not in self._prepared:   # a segment's rows are grouped once, not at every iteration
             self._prepared[(lo, hi)] = prepare(self.rows.iloc[lo:hi])
@@ -319,8 +320,8 @@ class TrackingProblem:
         observed = rows["value"].to_numpy(float)
         value = np.where(np.isfinite(observed), observed - res, ev.value)  # computed, wrapped to the observation
         for sc in trajs:
-            G_x[sc] = ev.partials.get(f"state:{sc}", np.zeros((m, 6)))
-            G_p[sc] = ev.partials.get(f"dynamic:{sc}", np.zeros((m, len(trajs[sc].param_names))))
+            G_x[sc] = ev.partials.get(f"state:{sc}", G_x[sc])
+            G_p[sc] = ev.partials.get(f"dynamic:{sc}", G_p[sc])
         params = self.registry.parameters
         columns = {col: rows[col].to_numpy() for col in _BIAS_KEYS.values() if col in rows}
         if any(p.kind == "bias" for p in params):
