@@ -295,7 +295,7 @@ class TrackingProblem:
         """The measurement set-up with every estimated oscillator's terms from ``x0``."""
         osc = dict(self.setup.oscillators)
         for i, p in enumerate(self.registry.parameters):
-            if p.kind == "clock":
+            if p.kind == "clock" and "oscillator" in p.info:   # not a clock polynomial (studies' 'clock' kind)
                 terms = list(osc.get(p.owner, (0.0, 0.0, 0.0)))
                 terms[2] = p.info.get("t_ref", terms[2])
                 terms[("y0", "y1").index(p.info["oscillator"])] = x0[i]
