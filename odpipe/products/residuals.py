@@ -187,7 +187,7 @@ def plot(res: pd.DataFrame, path, which: str = "postfit", title: str = "") -> No
     height = 2.8 * n
     fig = Figure(figsize=(10, height))
     FigureCanvasAgg(fig)
-    fig.subplots_adjust(left=0.09, right=0.98, top=1 - 0.35 / height, bottom=0.75 / height, hspace=0.12)
+    fig.subplots_adjust(left=0.09, right=0.955, top=1 - 0.35 / height, bottom=0.75 / height, hspace=0.12)
     axes = fig.subplots(n, 1, sharex=True, squeeze=False)[:, 0]
     for ax, obs in zip(axes, observables):
         scale, unit = display_scale(obs)
