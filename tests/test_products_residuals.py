@@ -79,7 +79,8 @@ def test_a_mean_that_rounds_to_zero_has_no_sign(res):
 
 
 @pytest.mark.parametrize("value, text", [(4516.098, "4520"), (0.52062, "0.521"), (12.0, "12.0"),
-                                         (-0.0124, "-0.0124"), (0.999999, "1.00")])
+                                         (-0.0124, "-0.0124"), (0.999999, "1.00"),
+                                         (0.52999, "0.530"), (9.9996, "10.0"), (0.0, "0.00")])
 def test_significant_figures(value, text):
     assert significant(value) == text
 

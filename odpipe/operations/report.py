@@ -57,7 +57,8 @@ def _round(t: np.ndarray, unit: str) -> np.ndarray:
 def significant(value: float, digits: int = 3) -> str:
     """``value`` to ``digits`` significant figures in positional notation, trailing zeros kept
     (4516.098 → "4520", 0.52062 → "0.521", 12 → "12.0"): a statistic at the precision it carries."""
-    return np.format_float_positional(float(value), precision=digits, unique=False, fractional=False,
+    rounded = float(f"{float(value):.{digits}g}")   # first, so a carry (0.52999 → 0.530) keeps its zeros
+    return np.format_float_positional(rounded, precision=digits, unique=False, fractional=False,
                                       trim="k").rstrip(".")
 
 
