@@ -31,6 +31,8 @@ is taken as 0 and the note says so.
 
 from __future__ import annotations
 
+from dataclasses import dataclass
+
 import numpy as np
 import pandas as pd
 
@@ -56,7 +58,14 @@ NOT_ASKED = "row not asked for: no correction"
 
 def calibrate(table: pd.DataFrame, model: MediaModel, *, target_itrs=None, ramps=None,
               catalog: StationCatalog | None = None, order: int | None = 10, rows=None):
-    """(table with media columns, per-pass coverage report).
+    """(table with media columns, per-pass coverage report): :func:`calibrated` and :func:`pass_report`."""
+    out = calibrated(table, model, target_itrs=target_itrs, ramps=ramps, catalog=catalog, order=order, rows=rows)
+    return out, pass_report(out)
+
+
+def calibrated(table: pd.DataFrame, model: MediaModel, *, target_itrs=None, ramps=None,
+               catalog: StationCatalog | None = None, order: int | None = 10, rows=None) -> pd.DataFrame:
+    """A copy of ``table`` with the media columns.
 
     ``ramps``: the uplink ramp table (or RampStore) beside the table, giving ramped rows their
     uplink frequency at transmission; ``order=None`` disables per-pass smoothing. ``rows``: a boolean
@@ -70,10 +79,11 @@ def calibrate(table: pd.DataFrame, model: MediaModel, *, target_itrs=None, ramps
         out = assign_passes(out)
     n = len(out)
     # a running Doppler count is a Doppler row of its mode (its interval: since the previous count)
-    obs = np.char.replace(out["observable"].to_numpy(dtype=str), "doppler_count_", "doppler_").astype(object)
+    obs = strings(out["observable"], str)
+    obs = np.char.replace(obs, "doppler_count_", "doppler_") if obs.size else obs
     ground = np.isin(obs, GROUND)
     wanted = np.ones(n, bool) if rows is None else np.asarray(rows, bool)
-    doppler = np.char.startswith(obs.astype(str), "doppler")
+    doppler = np.char.startswith(obs, "doppler")
     epoch = out["epoch"].to_numpy().astype("datetime64[ns]").view(np.int64)
     ct = np.where(doppler, out["count_time"].to_numpy(dtype=float), 0.0)
     start, end = interval_bounds(epoch, ct, out["tag"].to_numpy())
@@ -81,73 +91,115 @@ def calibrate(table: pd.DataFrame, model: MediaModel, *, target_itrs=None, ramps
 
     # rows without geometry (NaN light time) get no direction either, so no correction: 0 is a placeholder
     rtlt_ns = np.rint(np.nan_to_num(rtlt) * 1e9).astype(np.int64)
-    f_up, f_down, f_up_known = _frequencies(out, epoch - rtlt_ns, ramps)
+    f_up, f_down, f_up_known = _frequencies(out, obs, epoch - rtlt_ns, ramps)
     s = _samples(out, obs, ground & wanted, doppler, epoch, start, end, rtlt_ns, f_up, f_down)
     tropo, iono, lab_t, lab_i = _leg_delays(s, out, model, target_itrs, catalog)
-    if order is not None and len(s):
-        group = pd.MultiIndex.from_arrays([s["pass_id"], s["leg"], s["station"]]).codes
-        key = np.ravel_multi_index(group, [len(c) + 1 for c in group])
-        tsec = (s["t"].to_numpy() - s["t"].to_numpy().min()) * 1e-9
+    if order is not None and s.row.size:
+        key = np.ravel_multi_index((s.pass_code, s.up.astype(np.int64), s.station),
+                                   (s.pass_code.max() + 1, 2, len(s.stations)))
+        tsec = (s.t - s.t.min()) * 1e-9
         tropo = smooth_by_group(tsec, tropo, key, order)
         iono = smooth_by_group(tsec, iono, key, order)
-    iono = np.where(s["phase"].to_numpy(), -iono, iono)
-    rows, sign = s["row"].to_numpy(), s["sign"].to_numpy()
+    iono = np.where(s.phase, -iono, iono)
+    rows, sign = s.row, s.sign
     out["tropo_m"] = _row_sum(n, rows, sign * tropo, ground & wanted)
     out["iono_m"] = _row_sum(n, rows, sign * iono, ground & wanted)
     out["media_m"] = out["tropo_m"] + out["iono_m"]
     is_range = obs == "range"
-    bands, band_idx = np.unique(out["band_up"].to_numpy(dtype=str), return_inverse=True)
+    bands, band_idx = np.unique(strings(out["band_up"], str), return_inverse=True)
     f_ru = f_up_known * range_unit_factor(bands)[band_idx]
     out["media_ru"] = np.where(is_range, out["media_m"].to_numpy() / C_LIGHT * f_ru, np.nan)
-    code, texts = pd.factorize("tropo: " + pd.Series(lab_t) + " | iono: " + pd.Series(lab_i))
+    code, texts = _source_texts(lab_t, lab_i)
     texts = np.append(np.asarray(texts, dtype=object), "")
-    for leg, col in (("down", "media_source"), ("up", "media_source_up")):
-        pick = (sign > 0) & (s["leg"].to_numpy() == leg)
+    for leg_up, col in ((False, "media_source"), (True, "media_source_up")):
+        pick = (sign > 0) & (s.up == leg_up)
         row_code = np.full(n, len(texts) - 1)
         row_code[rows[pick]] = code[pick]
         out[col] = pd.Categorical(texts[row_code])
     out["media_note"] = _notes(n, rows, code, texts.astype(str), ground, np.isin(obs, TWO_LEG), rtlt_note, wanted)
-    return out, pass_report(out)
+    return out
 
 
-def _samples(t, obs, ground, doppler, epoch, start, end, rtlt_ns, f_up, f_down) -> pd.DataFrame:
-    """One sample per (row, leg, instant): the station, its ground time (ns) and the leg frequency.
+def strings(column: pd.Series, dtype=object) -> np.ndarray:
+    """A column as a numpy array of ``dtype``, each distinct value converted once (a str column of
+    many rows holds few names)."""
+    codes, names = pd.factorize(column, use_na_sentinel=False)
+    return np.asarray(names.to_numpy(dtype=dtype))[codes]
+
+
+def _source_texts(lab_t, lab_i):
+    """(code per sample, texts): ``"tropo: <lab_t> | iono: <lab_i>"`` of each sample, as codes into the
+    distinct texts in order of first appearance (as :func:`pandas.factorize`), each text built once."""
+    ct, names_t = pd.factorize(lab_t)
+    ci, names_i = pd.factorize(lab_i)
+    pair, first = np.unique(ct * len(names_i) + ci, return_index=True)
+    order = np.argsort(first, kind="stable")     # distinct pairs in order of first appearance
+    rank = np.empty(order.size, np.int64)
+    rank[order] = np.arange(order.size)
+    code = rank[np.searchsorted(pair, ct * len(names_i) + ci)]
+    p = pair[order]
+    texts = np.array(["tropo: " + names_t[k // len(names_i)] + " | iono: " + names_i[k % len(names_i)] for k in p],
+                     dtype=object)
+    return code, texts
+
+
+@dataclass(frozen=True)
+class _Samples:
+    """One sample per (row, leg, instant), as arrays: its ``row``, leg (``up``: the uplink), ``sign``
+    (+1 the count's end or a range's tag, -1 a Doppler count's start), ``station`` (index into
+    ``stations``; -1 none), ground time ``t`` (int64 ns UTC), leg frequency ``f`` (Hz), ``phase``
+    (a Doppler row: phase delay), ``pass_code`` (the row's pass, numbered from 0) and ``spacecraft``
+    (index into ``spacecraft_names``; -1 none)."""
+
+    row: np.ndarray
+    up: np.ndarray
+    sign: np.ndarray
+    station: np.ndarray
+    t: np.ndarray
+    f: np.ndarray
+    phase: np.ndarray
+    pass_code: np.ndarray
+    spacecraft: np.ndarray
+    stations: np.ndarray
+    spacecraft_names: np.ndarray
+
+
+def _samples(t, obs, ground, doppler, epoch, start, end, rtlt_ns, f_up, f_down) -> _Samples:
+    """The samples of the rows ``ground``: the station, its ground time (ns) and the leg frequency.
 
     Range rows have one instant (the tag); Doppler rows two, the count's end (sign +1) and
     start (sign -1). Uplink instants are one round-trip light time before reception.
     """
+    n = len(t)
+    names = pd.factorize(np.concatenate([strings(t["station_rx"]), strings(t["station_tx"])]))
+    rx, tx = names[0][:n], names[0][n:]
     parts = []
     up_rows = ground & np.isin(obs, TWO_LEG)
-    for leg, stations, freq, leg_rows, shift in (("down", t["station_rx"], f_down, ground, 0),
-                                                 ("up", t["station_tx"], f_up, up_rows,
-                                                  rtlt_ns)):
+    for up, station, freq, leg_rows, shift in ((False, rx, f_down, ground, 0), (True, tx, f_up, up_rows, rtlt_ns)):
         for sign, at in ((1.0, np.where(doppler, end, epoch)), (-1.0, start)):
             rows = np.flatnonzero(leg_rows & ((sign > 0) | doppler))
-            parts.append(pd.DataFrame({"row": rows, "leg": leg, "sign": sign,
-                                       "station": stations.to_numpy(dtype=object)[rows],
-                                       "t": (at - shift)[rows], "f": freq[rows]}))
-    s = pd.concat(parts, ignore_index=True)
-    r = s["row"].to_numpy()
-    s["phase"] = doppler[r]
-    s["pass_id"] = t["pass_id"].to_numpy()[r]
-    s["spacecraft"] = t["spacecraft"].to_numpy(dtype=object)[r]
-    return s
+            parts.append((rows, np.full(rows.size, up), np.full(rows.size, sign), station[rows], (at - shift)[rows],
+                          freq[rows]))
+    row, up, sign, station, when, f = (np.concatenate(c) for c in zip(*parts))
+    sc, sc_names = pd.factorize(t["spacecraft"].to_numpy(dtype=object)[row])
+    return _Samples(row, up, sign, station, when, f, doppler[row], pd.factorize(t["pass_id"].to_numpy()[row])[0],
+                    sc, np.asarray(names[1], dtype=object), np.asarray(sc_names, dtype=object))
 
 
-def _frequencies(t: pd.DataFrame, tx_ns, ramps):
+def _frequencies(t: pd.DataFrame, obs, tx_ns, ramps):
     """(uplink Hz, downlink Hz) per row: table value or ramp at transmission, turnaround, else nominal."""
     up = t["uplink_hz"].to_numpy(dtype=float).copy()
     store = ramp_segments.store(ramps)
     ramped = t["ramped"].to_numpy(dtype=bool) & np.isnan(up)
     if store is not None and ramped.any():
-        tx_station = t["station_tx"].to_numpy(dtype=object)[ramped]
+        tx_station = strings(t["station_tx"])[ramped]
         up[ramped] = store.frequency(tx_station, tx_ns[ramped].view("datetime64[ns]"))
     nominal = {}
     for leg, col in (("up", "band_up"), ("down", "band_down")):
-        bands, idx = np.unique(t[col].to_numpy(dtype=str), return_inverse=True)
+        bands, idx = np.unique(strings(t[col], str), return_inverse=True)
         nominal[leg] = np.array([NOMINAL_HZ.get((leg, b.upper()), np.nan) for b in bands])[idx]
     f_up = np.where(np.isfinite(up), up, nominal["up"])
-    one_way = t["observable"].to_numpy(dtype=object) == "doppler_1way"
+    one_way = strings(t["observable"]) == "doppler_1way"
     turned = f_up * t["transponder_ratio"].to_numpy(dtype=float)
     f_down = np.where(one_way & np.isfinite(up), up, np.where(np.isfinite(turned), turned, nominal["down"]))
     return f_up, f_down, up
@@ -169,31 +221,39 @@ def _round_trip(t: pd.DataFrame, target_itrs, catalog, epoch_ns):
     return rtlt, ""
 
 
-def _leg_delays(s: pd.DataFrame, table, model: MediaModel, target_itrs, catalog):
+def _leg_delays(s: _Samples, table, model: MediaModel, target_itrs, catalog):
     """Group delays (troposphere, ionosphere, m) and their source labels per sample."""
-    m = len(s)
+    m = s.row.size
     tropo, iono = np.full(m, np.nan), np.full(m, np.nan)
     lab_t = np.full(m, "no station", dtype=object)
     lab_i = lab_t.copy()
-    t_all = s["t"].to_numpy().view("datetime64[ns]")
-    for name, idx in s.groupby("station").indices.items():
-        if name not in catalog:
+    t_all = s.t.view("datetime64[ns]")
+    known = [k for k, name in enumerate(s.stations) if name in catalog]
+    by_station = pd.Series(np.arange(m)).groupby(s.station).indices
+    target = _target_positions(t_all, np.isin(s.station, known), target_itrs) if target_itrs is not None else None
+    for k in known:
+        if k not in by_station:
             continue
+        idx, name = by_station[k], s.stations[k]
         st = catalog[name]
         lat, lon, h = itrs_to_geodetic(st.r_itrs)
         lat_c = np.arctan2(st.r_itrs[2], np.hypot(st.r_itrs[0], st.r_itrs[1]))     # for the spherical shell
         t = t_all[idx]
-        az, el = _direction(name, t, table, target_itrs, st)
+        tu, first, back = np.unique(t, return_index=True, return_inverse=True)   # a count's end is the next start
+        az, el = _direction(name, tu, table, None if target is None else target[1][target[0][idx[first]]], st)
+        d_t, l_t = model.troposphere(name, tu, np.where(el > 0.0, el, np.pi / 2), lat, h)   # once per time
+        az, el, d_t, l_t = az[back], el[back], d_t[back], l_t[back]
         bad = ~(el > 0.0)        # no direction, or below the horizon
         el_ok = np.where(bad, np.pi / 2, el)
         az_ok = np.where(bad, 0.0, az)
-        d_t, l_t = model.troposphere(name, t, el_ok, lat, h)
-        for sc, sub in pd.Series(np.arange(idx.size)).groupby(s["spacecraft"].to_numpy()[idx]).indices.items():
-            d_i, l_i = model.ionosphere(name, sc, t[sub], el_ok[sub], az_ok[sub], lat_c, lon,
-                                        s["f"].to_numpy()[idx][sub])
+        for sc, sub in pd.Series(np.arange(idx.size)).groupby(s.spacecraft[idx]).indices.items():
+            if sc < 0:
+                continue
+            d_i, l_i = model.ionosphere(name, s.spacecraft_names[sc], t[sub], el_ok[sub], az_ok[sub], lat_c, lon,
+                                        s.f[idx][sub])
             iono[idx[sub]] = np.where(bad[sub], np.nan, d_i)
             lab_i[idx[sub]] = np.where(bad[sub], "no direction", l_i)
-        optical = _optical(table, s["row"].to_numpy()[idx], el_ok, lat, h)
+        optical = _optical(table, s.row[idx], el_ok, lat, h)
         if optical is not None:
             laser, d_o, l_o = optical
             d_t, l_t = np.where(laser, d_o, d_t), np.where(laser, l_o, l_t)
@@ -202,6 +262,15 @@ def _leg_delays(s: pd.DataFrame, table, model: MediaModel, target_itrs, catalog)
         tropo[idx] = np.where(bad, np.nan, d_t)
         lab_t[idx] = np.where(bad, "no direction", l_t)
     return tropo, iono, lab_t, lab_i
+
+
+def _target_positions(t, use, target_itrs):
+    """(index per sample into the distinct times of the samples ``use`` (-1: not used), the target's ITRS
+    positions m at those times): the target is asked once per ground time, whichever stations share it."""
+    u, back = np.unique(t[use], return_inverse=True)
+    index = np.full(t.size, -1)
+    index[use] = back
+    return index, np.asarray(target_itrs(u))
 
 
 def _optical(table, rows, elevation, lat, h):
@@ -230,12 +299,12 @@ def _optical(table, rows, elevation, lat, h):
     return laser, delay, label.astype(object)
 
 
-def _direction(station, t, table, target_itrs, st):
-    """(azimuth, elevation) rad at a station at UTC times from the target or the table's columns."""
-    if target_itrs is not None:
-        u, back = np.unique(t, return_inverse=True)   # a count's end is the next one's start
-        az, el, _ = topocentric(st, np.asarray(target_itrs(u)), u)
-        return az[back], el[back]
+def _direction(station, t, table, target, st):
+    """(azimuth, elevation) rad at a station at UTC times ``t`` from the target's ITRS positions there (m)
+    or, when None, the table's columns."""
+    if target is not None:
+        az, el, _ = topocentric(st, target, t)
+        return az, el
     if "elevation_rx" not in table.columns:
         return np.full(t.size, np.nan), np.full(t.size, np.nan)
     rows = table[table["station_rx"] == station]

@@ -22,7 +22,7 @@ from odpipe import __version__
 from odpipe.analysis import maneuvers as maneuver_report
 from odpipe.analysis import station_diagnostics
 from odpipe.estimation.maneuvers import detect_maneuvers
-from odpipe.media.apply import calibrate
+from odpipe.media.apply import calibrated
 from odpipe.media.ionosphere import IonexModel
 from odpipe.media.model import MediaModel
 from odpipe.od.arc import ManeuverPlan, a_priori_reference, fit_arc
@@ -126,9 +126,9 @@ def _run(cfg: RunConfig, attempt, log: RunLog, fingerprint: dict) -> dict:
                            IonexModel(read_ionex(*cal.ionex)) if cal.ionex else None, cal.standard_troposphere)
 
         def media(rows, trajectory):   # only the rows of the fitted observables are corrected
-            return calibrate(rows, model, target_itrs=apparent_itrs(trajectory, fm.ephemeris), ramps=data.store,
-                             catalog=catalog, order=None if cal.smoothing_order < 0 else cal.smoothing_order,
-                             rows=fitted_rows(rows, cfg.data.observables))[0]
+            return calibrated(rows, model, target_itrs=apparent_itrs(trajectory, fm.ephemeris), ramps=data.store,
+                              catalog=catalog, order=None if cal.smoothing_order < 0 else cal.smoothing_order,
+                              rows=fitted_rows(rows, cfg.data.observables))
 
         table = media(table, apriori)
         log(f"calibrate: media on {int(np.isfinite(table['media_m']).sum())} rows; "
