@@ -44,12 +44,12 @@ def add_geometry(table: pd.DataFrame, trajectory, ephemeris, catalog) -> pd.Data
         idx = idx[(t[idx] >= lo) & (t[idx] <= hi)]
         if idx.size == 0:
             continue
-        e, ti = epochs[idx], t[idx]
+        e, first, back = np.unique(epochs[idx], return_index=True, return_inverse=True)  # rows sharing a time
         rot = gcrs_to_itrs(e)
         r_sta = np.einsum("nji,nj->ni", rot, st.position_itrs(e))  # GCRS
-        r_sc = _light_time_corrected(trajectory, ephemeris, ti, r_sta)
+        r_sc = _light_time_corrected(trajectory, ephemeris, t[idx][first], r_sta)
         a, el_i, rng = topocentric(st, np.einsum("nij,nj->ni", rot, r_sc), e)
-        el[idx], az[idx], rtlt[idx] = el_i, a, 2.0 * rng / C_LIGHT
+        el[idx], az[idx], rtlt[idx] = el_i[back], a[back], 2.0 * rng[back] / C_LIGHT
     out["elevation_rx"], out["azimuth_rx"], out["rtlt_s"] = el, az, rtlt
     return out
 
