@@ -337,9 +337,12 @@ class ReferenceChain:
     def state(self, t) -> np.ndarray:
         t = np.atleast_1d(np.asarray(t, float))
         k = np.clip(np.searchsorted(self.starts, t, "right") - 1, 0, len(self.trajectories) - 1)
+        order = np.argsort(k, kind="stable")   # each segment's epochs as one slice
+        bounds = np.searchsorted(k[order], np.arange(len(self.trajectories) + 1))
         out = np.empty((t.size, 6))
-        for j in np.unique(k):
-            out[k == j] = self.trajectories[j].state(t[k == j])
+        for j in np.flatnonzero(np.diff(bounds)):
+            at = order[bounds[j]:bounds[j + 1]]
+            out[at] = self.trajectories[j].state(t[at])
         return out
 
 
