@@ -7,6 +7,8 @@ sampling thread reads the main thread's Python stack every ``interval`` seconds.
 interval's wall time goes to the innermost frame that belongs to a stage:
 
     ingest          parsers/ (but parsers/atomic.py), odpipe/pipeline/ingest.py
+    geometry        odpipe/pipeline/geometry.py (elevation, azimuth, light time of every row; the media's
+                    spacecraft directions)
     media           odpipe/media/
     compression     odpipe/preprocess/compress.py
     editing         the rest of odpipe/preprocess/
@@ -16,14 +18,15 @@ interval's wall time goes to the innermost frame that belongs to a stage:
     smoother        odpipe/estimation/smoother.py
     products        odpipe/products/, odpipe/operations/, odpipe/pipeline/fitted_trajectory.py, run.py:_products,
                     parsers/atomic.py (file writes)
-    set-up          the rest of odpipe/pipeline (force model, a priori trajectory, geometry)
+    set-up          the rest of odpipe/pipeline (force model, gravity file, a priori state)
 
 Frames of odpipe/frames, odpipe/time, odpipe/environment, numpy, scipy and pandas are
 passed over (they count for the stage that called them). numba kernels hold the GIL, so
 a sample lands just after the kernel returns, in the frame that called it: stages are
 right to the length of one kernel call. Each interval is counted twice: wall seconds and the
 main thread's CPU seconds (its own clock, ``time.pthread_getcpuclockid``), the steadier figure
-on a loaded machine. Time inside ``odpipe.estimation.fit.fit`` is
+on a loaded machine. The process's own fixed costs are printed first, measured before the run: importing the
+pipeline and numba's first call (its runtime's start), CPU s. Time inside ``odpipe.estimation.fit.fit`` is
 also split by (fit call, iteration, weight stage). numba compilation (none when its
 cache is warm: run twice) is reported apart. Integrations and force-model evaluations
 (``Trajectory.n_eval``, independent of the machine's load) are counted by where
@@ -51,9 +54,24 @@ sys.path.insert(0, str(ROOT))
 for _var in ("OPENBLAS_NUM_THREADS", "OMP_NUM_THREADS", "MKL_NUM_THREADS"):   # as in a nightly's Dask workers
     os.environ.setdefault(_var, "1")
 
+_IMPORT_CPU = time.process_time()
 from odpipe.dynamics.compile_timer import compile_timer  # noqa: E402
 from odpipe.pipeline.run import run_config  # noqa: E402
 from odpipe.operations.schema import ConfigError  # noqa: E402
+_IMPORT_CPU = time.process_time() - _IMPORT_CPU
+
+
+def numba_start() -> float:
+    """CPU s of the process's first numba call (its runtime's start and one small cached kernel), made
+    before the run so that no stage is charged with it."""
+    import numpy as np
+
+    from odpipe.numerics.interpolation import lagrange4_uniform
+
+    t = time.process_time()
+    lagrange4_uniform(0.0, 1.0, np.zeros(4), np.array([1.5]))
+    return time.process_time() - t
+
 
 STAGES = [  # (path fragment, stage): the first fragment found in a frame's file name wins
     ("/parsers/atomic.py", "products"),   # the products' atomic file writes
@@ -66,9 +84,10 @@ STAGES = [  # (path fragment, stage): the first fragment found in a frame's file
     ("/odpipe/estimation/", "filter"), ("/odpipe/od/", "filter"),
     ("/odpipe/products/", "products"), ("/odpipe/operations/", "products"),
     ("/odpipe/pipeline/fitted_trajectory.py", "products"),
+    ("/odpipe/pipeline/geometry.py", "geometry"),
     ("/odpipe/pipeline/", "set-up"),
 ]
-ORDER = ["ingest", "set-up", "media", "compression", "editing", "integration", "light time and partials",
+ORDER = ["ingest", "set-up", "geometry", "media", "compression", "editing", "integration", "light time and partials",
          "filter", "smoother", "products", "other"]
 
 
@@ -171,6 +190,8 @@ def main(argv=None) -> int:
     ap.add_argument("--cprofile", type=int, default=0, metavar="N",
                     help="also profile with cProfile on the CPU clock and print its top N functions")
     args = ap.parse_args(argv)
+    print(f"import of the pipeline: {_IMPORT_CPU:.2f} CPU s; numba's first call: {numba_start():.2f} CPU s "
+          "(both before the run)")
     profiler = cProfile.Profile(time.process_time) if args.cprofile else None
     sampler = Sampler(threading.get_ident(), args.interval)
     sampler.start()
