@@ -9,7 +9,7 @@ bit-identical target positions). Row labels and sources equal the straightforwar
 import numpy as np
 import pandas as pd
 
-from odpipe.media.apply import _source_texts, calibrate, calibrated, strings
+from odpipe.media.apply import _source_texts, calibrate, calibrated, categorical, strings
 from odpipe.media.model import MediaModel
 from parsers import table as tt
 
@@ -85,3 +85,11 @@ def test_source_texts_equal_the_concatenated_labels_factorized():
     expected_code, expected_texts = pd.factorize("tropo: " + pd.Series(lab_t) + " | iono: " + pd.Series(lab_i))
     np.testing.assert_array_equal(code, expected_code)
     assert list(texts) == list(expected_texts)
+
+
+def test_categorical_equals_the_categorical_of_the_texts_row_by_row():
+    texts = np.array(["no TRO; none", "", "no direction", ""], dtype=object)   # a text may repeat
+    codes = np.array([0, 1, 3, 3, 0, 2, 1])
+    pd.testing.assert_series_equal(pd.Series(categorical(codes, texts)), pd.Series(pd.Categorical(texts[codes])))
+    pd.testing.assert_series_equal(pd.Series(categorical(codes[:2], texts)),   # only the texts present
+                                   pd.Series(pd.Categorical(texts[codes[:2]])))

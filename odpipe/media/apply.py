@@ -115,7 +115,7 @@ def calibrated(table: pd.DataFrame, model: MediaModel, *, target_itrs=None, ramp
         pick = (sign > 0) & (s.up == leg_up)
         row_code = np.full(n, len(texts) - 1)
         row_code[rows[pick]] = code[pick]
-        out[col] = pd.Categorical(texts[row_code])
+        out[col] = categorical(row_code, texts)
     out["media_note"] = _notes(n, rows, code, texts.astype(str), ground, np.isin(obs, TWO_LEG), rtlt_note, wanted)
     return out
 
@@ -125,6 +125,14 @@ def strings(column: pd.Series, dtype=object) -> np.ndarray:
     many rows holds few names)."""
     codes, names = pd.factorize(column, use_na_sentinel=False)
     return np.asarray(names.to_numpy(dtype=dtype))[codes]
+
+
+def categorical(codes: np.ndarray, texts: np.ndarray) -> pd.Categorical:
+    """``pd.Categorical(texts[codes])`` (categories: the distinct texts present, sorted), each distinct
+    code's text looked at once instead of once per row."""
+    present, inverse = np.unique(codes, return_inverse=True)
+    categories, to_category = np.unique(texts[present].astype(str), return_inverse=True)
+    return pd.Categorical.from_codes(to_category[inverse], pd.Index(categories, dtype="str"))
 
 
 def _source_texts(lab_t, lab_i):
@@ -181,9 +189,9 @@ def _samples(t, obs, ground, doppler, epoch, start, end, rtlt_ns, f_up, f_down) 
             parts.append((rows, np.full(rows.size, up), np.full(rows.size, sign), station[rows], (at - shift)[rows],
                           freq[rows]))
     row, up, sign, station, when, f = (np.concatenate(c) for c in zip(*parts))
-    sc, sc_names = pd.factorize(t["spacecraft"].to_numpy(dtype=object)[row])
+    sc, sc_names = pd.factorize(t["spacecraft"])
     return _Samples(row, up, sign, station, when, f, doppler[row], pd.factorize(t["pass_id"].to_numpy()[row])[0],
-                    sc, np.asarray(names[1], dtype=object), np.asarray(sc_names, dtype=object))
+                    sc[row], np.asarray(names[1], dtype=object), np.asarray(sc_names.to_numpy(dtype=object)))
 
 
 def _frequencies(t: pd.DataFrame, obs, tx_ns, ramps):
@@ -346,7 +354,7 @@ def _notes(n, rows, code, texts, ground, two_leg, rtlt_note, wanted):
     words = [text for _, text in reasons] + [text for _, text in extra]
     uniq, inv = np.unique(bits, return_inverse=True)
     names = ["; ".join(w for k, w in enumerate(words) if u >> k & 1 and w) for u in uniq]
-    return pd.Categorical(np.asarray(names, dtype=object)[inv])
+    return categorical(inv, np.asarray(names, dtype=object))
 
 
 def pass_report(t: pd.DataFrame) -> pd.DataFrame:
