@@ -236,19 +236,16 @@ def _leg_delays(s: _Samples, table, model: MediaModel, target_itrs, catalog):
     lab_t = np.full(m, "no station", dtype=object)
     lab_i = lab_t.copy()
     t_all = s.t.view("datetime64[ns]")
-    known = [k for k, name in enumerate(s.stations) if name in catalog]
-    by_station = pd.Series(np.arange(m)).groupby(s.station).indices
-    target = _target_positions(t_all, np.isin(s.station, known), target_itrs) if target_itrs is not None else None
-    for k in known:
-        if k not in by_station:
+    for k, idx in pd.Series(np.arange(m)).groupby(s.station).indices.items():
+        name = s.stations[k] if k >= 0 else None
+        if name not in catalog:
             continue
-        idx, name = by_station[k], s.stations[k]
         st = catalog[name]
         lat, lon, h = itrs_to_geodetic(st.r_itrs)
         lat_c = np.arctan2(st.r_itrs[2], np.hypot(st.r_itrs[0], st.r_itrs[1]))     # for the spherical shell
         t = t_all[idx]
-        tu, first, back = np.unique(t, return_index=True, return_inverse=True)   # a count's end is the next start
-        az, el = _direction(name, tu, table, None if target is None else target[1][target[0][idx[first]]], st)
+        tu, back = np.unique(t, return_inverse=True)   # a count's end is the next one's start
+        az, el = _direction(name, tu, table, None if target_itrs is None else np.asarray(target_itrs(tu)), st)
         d_t, l_t = model.troposphere(name, tu, np.where(el > 0.0, el, np.pi / 2), lat, h)   # once per time
         az, el, d_t, l_t = az[back], el[back], d_t[back], l_t[back]
         bad = ~(el > 0.0)        # no direction, or below the horizon
@@ -270,15 +267,6 @@ def _leg_delays(s: _Samples, table, model: MediaModel, target_itrs, catalog):
         tropo[idx] = np.where(bad, np.nan, d_t)
         lab_t[idx] = np.where(bad, "no direction", l_t)
     return tropo, iono, lab_t, lab_i
-
-
-def _target_positions(t, use, target_itrs):
-    """(index per sample into the distinct times of the samples ``use`` (-1: not used), the target's ITRS
-    positions m at those times): the target is asked once per ground time, whichever stations share it."""
-    u, back = np.unique(t[use], return_inverse=True)
-    index = np.full(t.size, -1)
-    index[use] = back
-    return index, np.asarray(target_itrs(u))
 
 
 def _optical(table, rows, elevation, lat, h):
