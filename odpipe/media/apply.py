@@ -74,9 +74,7 @@ def calibrated(table: pd.DataFrame, model: MediaModel, *, target_itrs=None, ramp
     depend on which other rows are corrected.
     """
     catalog = catalog or StationCatalog.default()
-    out = table.copy()
-    if (out["pass_id"] < 0).all() and len(out):
-        out = assign_passes(out)
+    out = assign_passes(table) if (table["pass_id"] < 0).all() and len(table) else table.copy()   # a copy
     n = len(out)
     # a running Doppler count is a Doppler row of its mode (its interval: since the previous count)
     obs = strings(out["observable"], str)
