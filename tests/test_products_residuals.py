@@ -45,6 +45,26 @@ def test_rms_per_station_and_pass_in_both_units(res):
     assert whole["los_unit"].tolist() == ["m/s"]
 
 
+def test_one_stations_s_and_x_band_one_way_are_kept_apart(res):
+    """GRAIL's S-band one-way counts against a transponder oscillator 70-100 times worse than the X-band
+    beacon's: a station's statistics per band, the edited-before counts from the tracking rows' band_down."""
+    res, los, _ = res
+    res = res.assign(observable="doppler_1way", band=np.where(np.arange(len(res)) % 2 == 0, "X", "S"))
+    before = pd.DataFrame({"station_rx": ["DSS-24"] * 3, "observable": "doppler_1way", "band_down": ["s", "S", "x"]})
+    stats = statistics(res, edited_before=before).set_index("band")
+    used = (res["flags"] == 0) & (res["status"] == "")
+    for band in ("S", "X"):
+        sel = used & (res["band"] == band)
+        assert stats.loc[band, "postfit_rms"] == pytest.approx(np.sqrt(np.mean(res.loc[sel, "postfit_los"] ** 2)),
+                                                               rel=1e-12)
+        assert stats.loc[band, "n_used"] == sel.sum()
+    assert stats.loc["S", "n_edited"] == 1 + 2 and stats.loc["X", "n_edited"] == 0 + 1   # row 5 is S-band
+    (_, table, _), = report_tables(stats.reset_index())
+    assert table["band"].tolist() == ["S", "X"]
+    (_, table, _), = report_tables(statistics(res.assign(band="")))
+    assert "band" not in table   # no band column where no row has one
+
+
 def test_report_tables_show_mm_per_s_and_the_observed_unit(res):
     res, los, hz_per_mps = res
     (caption, table, formats), = report_tables(statistics(res, by=("station_rx", "observable", "pass_id")))

@@ -35,7 +35,7 @@ from parsers import oem
 START, END = "2003-06-03T00:00:00", "2003-06-04T06:00:00"
 
 # Column headers without a unit: labels, counts and text.
-UNITLESS = {"station_rx", "observable", "pass_id", "n_used", "n_edited", "n_failed", "stage", "reason", "rows",
+UNITLESS = {"station_rx", "observable", "band", "pass_id", "n_used", "n_edited", "n_failed", "stage", "reason", "rows",
             "parameter", "kind", "maneuver", "overlap", "statistic", "arc", "error", "converged"}
 UNIT = re.compile(r"\((m|m/s|mm/s|s|ms|h|Hz|RU|%|1|1/s|m/s²|sigma|UTC|chi-square)\)$")
 ISO = re.compile(r"^\d{4}-\d\d-\d\dT\d\d:\d\d:\d\d(\.\d+)?$")

@@ -53,3 +53,13 @@ def band_name(band) -> str:
     """Canonical band name: S, X, Ka (case-insensitive input)."""
     b = str(band).strip()
     return "Ka" if b.upper() == "KA" else b.upper()
+
+
+def downlink_bands(rows) -> np.ndarray:
+    """Each tracking row's downlink band name (S, X, Ka) from its ``band_down``; "" where a row has none
+    (laser range, crosslinks, tables without the column)."""
+    if "band_down" not in rows:
+        return np.full(len(rows), "", dtype=object)
+    codes = rows["band_down"].astype(object).where(rows["band_down"].notna(), "").astype(str)
+    names = {b: band_name(b) if b else "" for b in codes.unique()}
+    return codes.map(names).to_numpy(object)

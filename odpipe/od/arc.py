@@ -27,7 +27,7 @@ from odpipe.estimation.fit import EDIT_INNOVATION, NONFINITE, FitOptions, Observ
 from odpipe.estimation.maneuvers import maneuver_table
 from odpipe.estimation.registry import GaussMarkov, ParameterRegistry
 from odpipe.measurements import MeasurementSetup, oscillators
-from odpipe.measurements.bands import band_name
+from odpipe.measurements.bands import band_name, downlink_bands
 from odpipe.measurements.compute import spanning
 from odpipe.od.outward import labelled
 from odpipe.preprocess.flags import Flag
@@ -458,6 +458,7 @@ def _solution(setup, reg, problem, sol, rows, times, to_los, status, apriori) ->
                         "observable": rows["observable"].to_numpy(), "station_rx": rows["station_rx"].to_numpy(),
                         "pass_id": rows["pass_id"].to_numpy(), "time": times, "to_los": to_los,
                         "status": status})
+    res.insert(4, "band", downlink_bands(rows))
     if "unit" in rows:
         res.insert(4, "unit", rows["unit"].astype(str).to_numpy())
     res["apriori"] = np.where(good, apriori, np.nan)

@@ -239,7 +239,7 @@ def _products(cfg, attempt, log, table, arc, edits, fit_seconds, findings, finge
     write_parquet(attempt.product("tracking.parquet"), table)
     write_parquet(attempt.product("residuals.parquet"), res)
     write_text(attempt.product("residual_statistics.csv"), stats.to_csv(index=False))
-    per_pass = residuals.statistics(res, by=("station_rx", "observable", "pass_id"), edited_before=before)
+    per_pass = residuals.statistics(res, by=("station_rx", "observable", "band", "pass_id"), edited_before=before)
     write_text(attempt.product("residual_statistics_passes.csv"), per_pass.to_csv(index=False))
     diag = station_diagnostics.diagnose(station_diagnostics.rows_used(res, table, ramps), params=arc.parameters)
     write_text(attempt.product("station_diagnostics.csv"), diag.to_csv(index=False))

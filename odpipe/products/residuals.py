@@ -14,6 +14,7 @@ import pandas as pd
 
 from odpipe.constants import C_LIGHT
 from odpipe.measurements import oscillators
+from odpipe.measurements.bands import downlink_bands
 from odpipe.operations.report import decimals, significant
 from parsers.atomic import save_figure
 
@@ -85,20 +86,23 @@ def _rms(x) -> float:
 LOS_UNIT = {True: "m/s", False: "m"}
 
 
-def statistics(res: pd.DataFrame, by=("station_rx", "observable"), edited_before=None) -> pd.DataFrame:
-    """Per group: rows fitted (``n_used``), edited by the fit or, the tracking rows ``edited_before`` (e.g. the
+def statistics(res: pd.DataFrame, by=("station_rx", "observable", "band"), edited_before=None) -> pd.DataFrame:
+    """Per group (a key the frame lacks is left out: ``band``, the downlink band, keeps one station's S- and
+    X-band one-way apart): rows fitted (``n_used``), edited by the fit or, the tracking rows ``edited_before`` (e.g. the
     a priori blunder test's), before it (``n_edited``) and not computable by the
     models (``n_failed``); first and last epoch (UTC) of the used rows; mean and RMS of the post-fit and
     RMS of the pre-fit residual (``apriori_orbit_los``, :func:`apriori_orbit_los`), all
     along the line of sight in ``los_unit`` (m or m/s); and the post-fit RMS in the observable's own
     unit (``postfit_rms_obs`` in ``obs_unit``, e.g. Hz, RU) when the residuals carry ``unit``."""
-    by = list(by)
+    by = [k for k in by if k in res]
     ok = res["status"].eq("") if "status" in res else pd.Series(True, index=res.index)
     used = res[ok & res["flags"].eq(0)]
     g = used.groupby(by, sort=True)
     out = pd.DataFrame({"n_used": g.size()})
     out["n_edited"] = _count(res[ok & res["flags"].ne(0)], by, out.index)
     if edited_before is not None:
+        if "band" in by and "band" not in edited_before:
+            edited_before = edited_before.assign(band=downlink_bands(edited_before))
         out["n_edited"] += _count(edited_before, by, out.index)
     out["n_failed"] = _count(res[~ok], by, out.index)
     if "epoch" in used:
@@ -131,7 +135,8 @@ def report_tables(stats: pd.DataFrame) -> list[tuple[str, pd.DataFrame, dict]]:
     for (obs, unit), sub in stats.groupby(["observable", stats.get("obs_unit", pd.Series("", index=stats.index))],
                                           sort=True):
         scale, shown = display_scale(obs)
-        t = sub[keys + ["n_used", "n_edited", "n_failed"]].copy()
+        shown_keys = [k for k in keys if k != "band" or sub[k].fillna("").ne("").any()]   # no empty band column
+        t = sub[shown_keys + ["n_used", "n_edited", "n_failed"]].copy()
         for col in ("start", "end"):
             if col in sub:
                 t[f"{col} (UTC)"] = pd.to_datetime(sub[col]).to_numpy("datetime64[ns]")
