@@ -11,7 +11,8 @@ Interface (what measurement models and estimators code against):
 * ``traj.param_names`` - dynamic parameters (see :mod:`odpipe.dynamics.forces`).
 * ``traj.segments`` - (t_start, t_end) of the integration segments (restarts at maneuvers,
   burn and empirical-batch boundaries); at a maneuver epoch the post-maneuver state is returned.
-* ``traj.n_steps``, ``traj.n_eval`` - accepted steps and force evaluations.
+* ``traj.n_steps``, ``traj.n_eval`` - accepted steps and force evaluations; ``traj.median_step`` -
+  the accepted steps' median length (s).
 
 Epochs outside the arc raise ``ValueError``. :class:`TrajectorySet` maps spacecraft
 names to trajectories.
@@ -39,6 +40,12 @@ class Trajectory:
         starts = np.array([min(p[0][0], p[0][-1]) for p in pieces])
         self._order = np.argsort(starts)
         self._starts = starts[self._order]
+
+    @property
+    def median_step(self) -> float:
+        """Median length (s) of the accepted steps; 0 without any."""
+        steps = np.concatenate([np.abs(np.diff(p[0])) for p in self._pieces])
+        return float(np.median(steps)) if steps.size else 0.0
 
     @property
     def segments(self) -> list[tuple[float, float]]:

@@ -7,6 +7,9 @@ maneuver at ``a``, whose dV is then added), and backward from ``x(a-)`` over a
 look-back of ``lookback`` s so that the light-time and count-interval events of
 the first rows (which precede their tags) are covered.
 
+The look-back's first step is the forward flight's median step (DOP853's own start, a few
+seconds in a low lunar orbit, would spend most of a 120-s look-back growing its steps).
+
 It offers the :class:`~odpipe.dynamics.trajectory.Trajectory` interface that
 the measurement models read, with
 
@@ -78,7 +81,7 @@ class SegmentTrajectory:
             x_plus[3:6] += self._dv
         self._fwd = propagate(x_plus, a, b, force_model, with_stm=True, params=list(params), **tol)
         self._back = propagate(self.x_start, a, a - lookback, force_model, with_stm=True,
-                               params=list(params), **tol)
+                               params=list(params), first_step=self._fwd.median_step, **tol)
         self.n_eval = self._fwd.n_eval + self._back.n_eval
         self._memo: dict = {float(a): (self.x_start, np.eye(6), np.eye(6), np.zeros((6, len(self.param_names))))}
 
