@@ -10,7 +10,6 @@ registered force's ``contribute`` (:mod:`odpipe.dynamics.force_registry`).
 
 from __future__ import annotations
 
-import numpy as np
 from numba import literal_unroll, njit, types
 from numba.extending import overload
 
