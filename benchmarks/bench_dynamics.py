@@ -7,6 +7,10 @@
     (LP165P), Sun, Venus, Mars, Jupiter, Saturn, SRP, STM.
 (c) 1 day of a 55-km lunar orbit: Moon 200x200 (LP lpe200) with partials to degree
     50, and to 8 as the GRAIL nightly asks; Earth and Sun point masses, STM.
+(d) the same day flown as a GRAIL-B fit flies it (runs/grail_b_2012_04_10.toml): 24 one-hour segments,
+    each integrated afresh with the STM and the sensitivities to the SRP scale and its hour's RTN
+    acceleration; Moon 150x150 with partials to 8, Earth and Sun, cannonball SRP with Earth and Moon
+    shadows, the exact references' tolerances (rtol 1e-11, atol 1e-5).
 
 Run: .venv/bin/python benchmarks/bench_dynamics.py  (compile time is reported apart).
 Each case reports wall and CPU time (the CPU time is the steadier figure on a shared machine).
@@ -21,7 +25,7 @@ from pathlib import Path
 import numpy as np
 
 from odpipe.dynamics.crtbp import EarthMoonUnits, propagate_crtbp
-from odpipe.dynamics.forces import (ForceModel, PointMasses, SolarRadiationPressure,
+from odpipe.dynamics.forces import (EmpiricalRTN, ForceModel, PointMasses, SolarRadiationPressure,
                                     SphericalHarmonics)
 from odpipe.dynamics.propagator import propagate
 from odpipe.environment.ephemeris import Ephemeris
@@ -124,6 +128,36 @@ def case_low_lunar(eph):
         report(f"  6x6 STM, field partials {partial}x{partial}", sec, traj)
 
 
+def case_grail_segments(eph):
+    t0 = float(utc_to_tdb(np.datetime64("2012-04-10T04:00:00"))[()])
+    lpe = read_gravity(DATA / "gravity/tudat/lpe200.txt")
+    r = lpe.radius + 55e3
+    v = np.sqrt(lpe.gm / r)
+    inc = np.radians(89.0)
+    x = np.array([r, 0.0, 0.0, 0.0, v * np.cos(inc), v * np.sin(inc)])
+    base = [SphericalHarmonics("moon", lpe, 150, partial_degree=8), PointMasses(["earth", "sun"]),
+            SolarRadiationPressure(cr_area=5.0)]
+    params = ["srp_scale", "emp[0].R", "emp[0].T", "emp[0].N"]
+    print("(d) 1 day at 55 km as 24 one-hour fit segments: Moon 150x150 (partials 8), Earth+Sun, SRP, "
+          "an RTN batch each, STM + 4 sensitivities")
+
+    def day():
+        y, trajs = x, []
+        for h in range(24):
+            a = t0 + 3600.0 * h
+            fm = ForceModel("moon", base + [EmpiricalRTN(np.array([[a - 1.0, a + 3601.0, 1e-8, -2e-8, 1e-8]]))],
+                            mass=220.0, ephemeris=eph)
+            trajs.append(propagate(y, a, a + 3600.0, fm, with_stm=True, params=params, rtol=1e-11, atol=1e-5))
+            y = trajs[-1].state(a + 3600.0)[0]
+        return trajs
+
+    sec, trajs = timed(day, repeat=2)
+    wall, cpu = sec
+    n_eval = sum(t.n_eval for t in trajs)
+    print(f"  {'24 segments':40s} {wall:8.3f} s (cpu {cpu:7.3f} s)  steps {sum(t.n_steps for t in trajs):6d}  "
+          f"evals {n_eval:7d}  {cpu / n_eval * 1e6:8.1f} cpu-us/eval")
+
+
 def main():
     eph = Ephemeris.open("de440")
     t, c = time.perf_counter(), time.process_time()
@@ -135,6 +169,7 @@ def main():
     case_peers(eph)
     case_libration(eph)
     case_low_lunar(eph)
+    case_grail_segments(eph)
 
 
 if __name__ == "__main__":

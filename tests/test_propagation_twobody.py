@@ -185,3 +185,16 @@ def test_rk4_is_fourth_order_and_its_dense_output_is_hermite():
     assert np.linalg.norm(mid[:3] - kepler(X0, t1 - 30.0)[:3]) < 2 * errs[1] + 1e-3
     with pytest.raises(ValueError, match="rk4"):
         propagate(X0, 0.0, t1, fm, method="rk4")                  # needs a step
+
+
+def test_first_step_replaces_the_starting_estimate():
+    """A given first step is the first step taken (accepted: two 60-s steps of 15 evaluations and the
+    initial one cover 120 s), the arc stays within the tolerance of Kepler's closed form, and DOP853's own
+    start (0.01 of the state's scale over its rate, under a second here) needs more steps."""
+    fm = ForceModel("earth", central_gm=GM)
+    default = propagate(X0, 0.0, -120.0, fm, with_stm=False, rtol=1e-11, atol=1e-5)
+    hinted = propagate(X0, 0.0, -120.0, fm, with_stm=False, rtol=1e-11, atol=1e-5, first_step=60.0)
+    assert (hinted.n_steps, hinted.n_eval, hinted.median_step) == (2, 31, 60.0)
+    assert default.n_steps > 2 and default.n_eval > 31
+    for traj in (default, hinted):
+        assert np.abs(traj.state(-120.0)[0][:3] - kepler(X0, -120.0)[:3]).max() < 1e-4

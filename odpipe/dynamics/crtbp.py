@@ -111,5 +111,5 @@ def propagate_crtbp(state0, t0: float, t1: float, mu: float, with_stm: bool = Tr
     y = np.asarray(state0, float).ravel().copy()
     if with_stm:
         y = np.concatenate([y, np.eye(6).ravel()])
-    ts, ys, Fs, n_eval = integrate(np.array([mu]), float(t0), y, float(t1), rtol, atol, np.inf, 6)
+    ts, ys, Fs, n_eval = integrate(np.array([mu]), float(t0), y, float(t1), rtol, atol, np.inf, 6, 0.0)
     return Trajectory("crtbp", t0, t1, [], [(ts, ys, Fs)], with_stm, n_eval)

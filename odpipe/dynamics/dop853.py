@@ -11,8 +11,11 @@ a step is accepted. The error norm
 covers the first ``n_err`` components only (the state; the variational part
 rides on the same steps). ``rtol = inf`` takes fixed steps of ``h_max`` (the last one
 shorter to land on t1) without error control, the way onboard filters integrate.
+``h_first > 0`` is the first step's length (s) instead of Hairer's starting heuristic (0.01 of
+the state's scale over its rate: a few seconds for a low lunar orbit, whose steps are about a
+minute, so that a short integration spends most of its steps growing from it).
 
-``integrate(model, t0, y0, t1, rtol, atol, h_max, n_err)`` -> (t (k+1,),
+``integrate(model, t0, y0, t1, rtol, atol, h_max, n_err, h_first)`` -> (t (k+1,),
 y (k+1, n), F (k, 7, n), n_eval). The right-hand side is ``derivative(t, y,
 model, dy)``, which each dynamics module implements with
 ``numba.extending.overload`` selected by the type of its ``model`` (the
@@ -81,7 +84,7 @@ def derivative(t, y, model, dy):
 
 
 @njit(cache=True)
-def integrate(model, t0, y0, t1, rtol, atol, h_max, n_err):
+def integrate(model, t0, y0, t1, rtol, atol, h_max, n_err, h_first):
     n = y0.shape[0]
     direction = 1.0 if t1 >= t0 else -1.0
     cap = 64
@@ -112,6 +115,8 @@ def integrate(model, t0, y0, t1, rtol, atol, h_max, n_err):
     d1 = np.sqrt(d1 / n_err)
     fixed = rtol == np.inf                       # fixed steps of h_max, no error control
     h_abs = 1e-6 if (d0 < 1e-5 or d1 < 1e-5) else 0.01 * d0 / d1
+    if h_first > 0.0:
+        h_abs = h_first
     h_abs = min(h_max if fixed else h_abs, h_max, span)
     rejected = False
     while True:

@@ -14,7 +14,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from odpipe.dynamics.force_registry import Force, kernel
-from odpipe.dynamics.rtn import rtn_acceleration, rtn_axes
+from odpipe.dynamics.rtn import add_rtn_axes, rtn_acceleration
 
 
 @dataclass
@@ -46,10 +46,7 @@ def _kernel(data, t, r, v, env, acc, grad_r, grad_v, dadp):
     for b in range(data.batches.shape[0]):
         if data.batches[b, 0] <= env.t_seg < data.batches[b, 1]:
             rtn_acceleration(r, v, data.batches[b, 2:5], acc, grad_r, grad_v)
-            axes = rtn_axes(r, v)
-            for c in range(3):
-                if data.rows[b, c] >= 0:
-                    dadp[data.rows[b, c]] += axes[:, c]
+            add_rtn_axes(r, v, data.rows[b], dadp)
 
 
 EMPIRICAL = Force("empirical", (EmpiricalRTN,), _compile, parameters=_parameters,

@@ -50,6 +50,8 @@ __all__ = ["AtmosphericDrag", "BODY_RADIUS", "CompiledModel", "Cylinder", "Empir
            "ForceModel", "ImpulsiveManeuver", "InertialPolynomialAcceleration", "Plate", "PointMasses",
            "ROTATION_GRID", "Relativity", "SolarRadiationPressure", "SphericalHarmonics", "compile_model"]
 
+SCRATCH_FIXED = 27   # the right-hand side's scratch: acceleration 3, d a/d r 9, d a/d v 9, an STM column 6; then d a/d p
+
 FORCES = (CENTRAL, THIRD_BODIES, HARMONICS, RELATIVITY, SRP, DRAG, EMPIRICAL, POLYNOMIAL, BURNS)
 Forces = namedtuple("Forces", [f.name for f in FORCES])
 
@@ -60,9 +62,11 @@ Forces = namedtuple("Forces", [f.name for f in FORCES])
 # mass        kg at the start; mass_flow: the finite burns' rows (odpipe.dynamics.thrust.burn_rows);
 # segment     (1,) mid-epoch (TDB s) of the segment being integrated, set by the propagator
 #             so that empirical batches and burns switch exactly at segment boundaries;
-# with_stm    whether the state carries the STM and sensitivities; n_params: rows of d a/d p.
+# with_stm    whether the state carries the STM and sensitivities; n_params: rows of d a/d p;
+# pos         (nbody, 3) the bodies' positions of the current evaluation, written by the kernel;
+# work        the right-hand side's scratch (odpipe.dynamics.rhs.scratch_size): no allocation per evaluation.
 CompiledModel = namedtuple("CompiledModel", ["forces", "eph_coeffs", "eph_t_start", "eph_t_step", "mass",
-                                             "mass_flow", "segment", "with_stm", "n_params"])
+                                             "mass_flow", "segment", "with_stm", "n_params", "pos", "work"])
 
 
 @dataclass
@@ -121,6 +125,7 @@ def compile_model(fm: ForceModel, t0: float, t1: float, params: Sequence[str], w
                          {b: i for i, b in enumerate(needed)}, fm.central_gm,
                          frozenset(s.body.lower() for s in fm.of_type(SphericalHarmonics)))
     forces = Forces(*(f.compile(comps, ctx) for f, comps in parts))
+    npar = len(params)
     return CompiledModel(forces, coeffs, float(t_start), float(t_step), float(fm.mass),
                          burn_rows(fm.of_type(FiniteBurn)), np.array([0.5 * (t0 + t1)]), bool(with_stm),
-                         len(params))
+                         npar, np.zeros((coeffs.shape[0], 3)), np.zeros(SCRATCH_FIXED + 3 * npar))

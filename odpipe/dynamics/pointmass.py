@@ -50,7 +50,7 @@ def central(r, gm, acc, grad):
 @njit(cache=True)
 def third_body(r, s, gm, acc, grad):
     """Add the direct and indirect acceleration of a body at ``s`` (m) with GM."""
-    d = s - r
+    d = (s[0] - r[0], s[1] - r[1], s[2] - r[2])
     dn2 = d[0] * d[0] + d[1] * d[1] + d[2] * d[2]
     dn = np.sqrt(dn2)
     sn = np.sqrt(s[0] * s[0] + s[1] * s[1] + s[2] * s[2])
@@ -97,8 +97,9 @@ def _third_kernel(data, t, r, v, env, acc, grad_r, grad_v, dadp):
         if data.direct[k]:
             third_body(r, s, data.gm[k], acc, grad_r)
         else:  # body carries SH: indirect point-mass term only
-            sn = np.sqrt(np.sum(s * s))
-            acc -= data.gm[k] * s / sn**3
+            sn = np.sqrt(s[0] * s[0] + s[1] * s[1] + s[2] * s[2])
+            for i in range(3):
+                acc[i] -= data.gm[k] * s[i] / sn**3
 
 
 CENTRAL = Force("central", (), _compile_central)

@@ -34,13 +34,14 @@ def _state_derivative(t, r, v, model):
 
 def propagate(state0, t0: float, t1: float, force_model: ForceModel, with_stm: bool = True,
               params: Sequence[str] | None = None, rtol: float = 1e-12, atol: float = 1e-9,
-              max_step: float = np.inf, method: str = "dop853") -> Trajectory:
+              max_step: float = np.inf, method: str = "dop853", first_step: float = 0.0) -> Trajectory:
     """Integrate ``state0`` (m, m/s, ICRF, relative to ``force_model.center``) from t0 to t1 (TDB s).
 
     ``params``: dynamic parameters to carry sensitivities for (default: all of the
     model's when ``with_stm``). ``rtol``/``atol`` (m and m/s) control the state error;
     ``rtol = inf`` integrates with fixed steps of ``max_step`` instead (8th order, no error control);
-    ``method = 'rk4'``: classical Runge-Kutta with fixed steps of ``max_step``.
+    ``method = 'rk4'``: classical Runge-Kutta with fixed steps of ``max_step``; ``first_step`` (s, > 0):
+    DOP853's first step instead of its own starting estimate.
     """
     if method not in ("dop853", "rk4") or (method == "rk4" and not np.isfinite(max_step)):
         raise ValueError(f"method must be 'dop853' or 'rk4' (with a finite max_step), not {method!r}")
@@ -69,7 +70,7 @@ def propagate(state0, t0: float, t1: float, force_model: ForceModel, with_stm: b
         try:
             ts, ys, Fs, ne = (integrate_rk4(model, float(t_a), y, float(t_b), float(max_step), 6)
                               if method == "rk4" else
-                              integrate(model, float(t_a), y, float(t_b), rtol, atol, max_step, 6))
+                              integrate(model, float(t_a), y, float(t_b), rtol, atol, max_step, 6, first_step))
         except RuntimeError as err:
             raise IntegrationError(f"{err} between TDB {t_a:.3f} and {t_b:.3f} s, starting "
                                    f"{np.linalg.norm(y[:3]) / 1e3:.3f} km from {force_model.center}") from err

@@ -79,15 +79,20 @@ SrpData = namedtuple("SrpData", ["on", "cr_area", "p_1au", "scale", "surfaces", 
 @njit(cache=True)
 def shadow_factor(r, r_sun, r_body, radius_body):
     """Fraction of the solar disc seen from ``r`` past one body (0 umbra .. 1 sunlit)."""
-    s_sun = r_sun - r
-    s_body = r_body - r
-    d_sun = np.sqrt(np.sum(s_sun * s_sun))
-    d_body = np.sqrt(np.sum(s_body * s_body))
+    return _shadow((r_sun[0] - r[0], r_sun[1] - r[1], r_sun[2] - r[2]),
+                   (r_body[0] - r[0], r_body[1] - r[1], r_body[2] - r[2]), radius_body)
+
+
+@njit(cache=True)
+def _shadow(s_sun, s_body, radius_body):
+    """:func:`shadow_factor` from the Sun and the body as seen from the spacecraft (3-tuples, m)."""
+    d_sun = np.sqrt(s_sun[0] * s_sun[0] + s_sun[1] * s_sun[1] + s_sun[2] * s_sun[2])
+    d_body = np.sqrt(s_body[0] * s_body[0] + s_body[1] * s_body[1] + s_body[2] * s_body[2])
     if d_body <= radius_body:
         return 0.0
     a = np.arcsin(min(1.0, R_SUN / d_sun))
     b = np.arcsin(min(1.0, radius_body / d_body))
-    cos_c = np.sum(s_sun * s_body) / (d_sun * d_body)
+    cos_c = (s_sun[0] * s_body[0] + s_sun[1] * s_body[1] + s_sun[2] * s_body[2]) / (d_sun * d_body)
     c = np.arccos(max(-1.0, min(1.0, cos_c)))
     if c >= a + b:
         return 1.0
@@ -160,25 +165,31 @@ def srp_acceleration(r, r_sun, nu, scale, p_1au, mass, cr_area, surfaces,
     ``nu`` shadow factor, ``scale`` the estimated multiplier, ``mass`` kg.
     Writes d a/d scale into d_scale (3,), d a/d rho into d_rho_s, d_rho_d (n, 3).
     """
-    w = r_sun - r
-    d = np.sqrt(np.sum(w * w))
-    e = w / d
+    w = (r_sun[0] - r[0], r_sun[1] - r[1], r_sun[2] - r[2])
+    d = np.sqrt(w[0] * w[0] + w[1] * w[1] + w[2] * w[2])
     p = p_1au * (AU / d) ** 2 * nu / mass
     ns = surfaces.shape[0]
-    F = -cr_area * e
-    J = -cr_area * np.eye(3)
-    dF_ds = np.zeros((ns, 3))
-    dF_dd = np.zeros((ns, 3))
+    buf = np.zeros(15 + 6 * ns)   # one allocation: e, F, J = d F / d e, dF_ds, dF_dd
+    e, F, J = buf[0:3], buf[3:6], buf[6:15].reshape((3, 3))
+    dF_ds, dF_dd = buf[15:15 + 3 * ns].reshape((ns, 3)), buf[15 + 3 * ns:].reshape((ns, 3))
+    for i in range(3):
+        e[i] = w[i] / d
+        F[i] = -cr_area * e[i]
+        J[i, i] = -cr_area
     surfaces_force(e, surfaces, F, dF_ds, dF_dd, J)
-    de_dr = -(np.eye(3) - np.outer(e, e)) / d
     for i in range(3):
         acc[i] += scale * p * F[i]
         d_scale[i] += p * F[i]
         for k in range(ns):
             d_rho_s[k, i] += scale * p * dF_ds[k, i]
             d_rho_d[k, i] += scale * p * dF_dd[k, i]
-    # p ~ 1/d^2 and d d/d r = -e^T
-    grad_r[:, :] += scale * p * (2.0 / d * np.outer(F, e) + J @ de_dr)
+    # p ~ 1/d^2 and d d/d r = -e^T; d e / d r = -(I - e e^T) / d
+    for i in range(3):
+        for j in range(3):
+            j_de = 0.0
+            for k in range(3):
+                j_de += J[i, k] * (-((1.0 if k == j else 0.0) - e[k] * e[j]) / d)
+            grad_r[i, j] += scale * p * (2.0 / d * F[i] * e[j] + j_de)
 
 
 def _parameters(components) -> list[str]:
@@ -226,13 +237,19 @@ def _kernel(data, t, r, v, env, acc, grad_r, grad_v, dadp):
         return
     r_sun = env.pos[data.sun_slot] if data.sun_slot >= 0 else np.zeros(3)
     nu = 1.0
+    s_sun = (r_sun[0] - r[0], r_sun[1] - r[1], r_sun[2] - r[2])
     for k in range(data.occ_radius.shape[0]):
-        r_b = env.pos[data.occ_slot[k]] if data.occ_slot[k] >= 0 else np.zeros(3)
-        nu *= shadow_factor(r, r_sun, r_b, data.occ_radius[k])
+        slot = data.occ_slot[k]
+        if slot >= 0:
+            s_body = (env.pos[slot, 0] - r[0], env.pos[slot, 1] - r[1], env.pos[slot, 2] - r[2])
+        else:   # the centre
+            s_body = (-r[0], -r[1], -r[2])
+        nu *= _shadow(s_sun, s_body, data.occ_radius[k])
     ns = data.surfaces.shape[0]
-    d_scale = np.zeros(3)
-    d_rs = np.zeros((ns, 3))
-    d_rd = np.zeros((ns, 3))
+    partials = np.zeros(3 + 6 * ns)   # one allocation: d a / d scale, d a / d rho_s, d a / d rho_d
+    d_scale = partials[0:3]
+    d_rs = partials[3:3 + 3 * ns].reshape((ns, 3))
+    d_rd = partials[3 + 3 * ns:].reshape((ns, 3))
     srp_acceleration(r, r_sun, nu, data.scale, data.p_1au, env.mass, data.cr_area, data.surfaces,
                      acc, grad_r, d_scale, d_rs, d_rd)
     if data.scale_row >= 0:

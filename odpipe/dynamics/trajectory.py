@@ -7,11 +7,13 @@ Interface (what measurement models and estimators code against):
 * ``traj.state(t) -> (N, 6)`` - position m, velocity m/s at TDB epochs ``t`` (scalar or array).
 * ``traj.stm(t) -> (N, 6, 6)`` - d state(t) / d state(t0), from the arc epoch t0 through
   any impulsive maneuvers (the impulse is state independent, so the STM is continuous).
-* ``traj.sensitivity(t) -> (N, 6, p)`` - d state(t) / d params for ``traj.param_names``.
+* ``traj.sensitivity(t) -> (N, 6, p)`` - d state(t) / d params for ``traj.param_names``;
+  ``traj.variational(t)`` gives the three from one interpolation.
 * ``traj.param_names`` - dynamic parameters (see :mod:`odpipe.dynamics.forces`).
 * ``traj.segments`` - (t_start, t_end) of the integration segments (restarts at maneuvers,
   burn and empirical-batch boundaries); at a maneuver epoch the post-maneuver state is returned.
-* ``traj.n_steps``, ``traj.n_eval`` - accepted steps and force evaluations.
+* ``traj.n_steps``, ``traj.n_eval`` - accepted steps and force evaluations; ``traj.median_step`` -
+  the accepted steps' median length (s).
 
 Epochs outside the arc raise ``ValueError``. :class:`TrajectorySet` maps spacecraft
 names to trajectories.
@@ -39,6 +41,12 @@ class Trajectory:
         starts = np.array([min(p[0][0], p[0][-1]) for p in pieces])
         self._order = np.argsort(starts)
         self._starts = starts[self._order]
+
+    @property
+    def median_step(self) -> float:
+        """Median length (s) of the accepted steps; 0 without any."""
+        steps = np.concatenate([np.abs(np.diff(p[0])) for p in self._pieces])
+        return float(np.median(steps)) if steps.size else 0.0
 
     @property
     def segments(self) -> list[tuple[float, float]]:
@@ -70,10 +78,14 @@ class Trajectory:
         return self._values(t)[:, 6:42].reshape(-1, 6, 6)
 
     def sensitivity(self, t) -> np.ndarray:
+        return self.variational(t)[2]
+
+    def variational(self, t) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """(state (N, 6), stm (N, 6, 6), sensitivity (N, 6, p)) from one interpolation."""
         if not self.with_stm:
             raise ValueError("trajectory propagated without the variational equations")
         v = self._values(t)
-        return v[:, 42:].reshape(len(v), 6, len(self.param_names))
+        return v[:, :6], v[:, 6:42].reshape(-1, 6, 6), v[:, 42:].reshape(len(v), 6, len(self.param_names))
 
 
 class TrajectorySet(dict):

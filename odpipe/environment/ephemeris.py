@@ -342,9 +342,16 @@ def _piece(coeffs, t_start, t_step, t):
 @njit(cache=True)
 def interp_positions(coeffs, t_start, t_step, t):
     """Positions (nbody, 3) m at TDB s ``t`` from Chebyshev pieces (Clenshaw)."""
+    out = np.empty((coeffs.shape[0], 3))
+    interp_positions_into(coeffs, t_start, t_step, t, out)
+    return out
+
+
+@njit(cache=True)
+def interp_positions_into(coeffs, t_start, t_step, t, out):
+    """:func:`interp_positions` written into ``out`` (nbody, 3) m: nothing allocated (the force kernel's)."""
     k, s = _piece(coeffs, t_start, t_step, t)
     nbody, _, _, ncoef = coeffs.shape
-    out = np.empty((nbody, 3))
     for b in range(nbody):
         for c in range(3):
             b1 = 0.0
@@ -354,7 +361,6 @@ def interp_positions(coeffs, t_start, t_step, t):
                 b2 = b1
                 b1 = b0
             out[b, c] = coeffs[b, k, c, 0] + s * b1 - b2
-    return out
 
 
 @njit(cache=True)

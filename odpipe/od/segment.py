@@ -7,6 +7,9 @@ maneuver at ``a``, whose dV is then added), and backward from ``x(a-)`` over a
 look-back of ``lookback`` s so that the light-time and count-interval events of
 the first rows (which precede their tags) are covered.
 
+The look-back's first step is the forward flight's median step (DOP853's own start, a few
+seconds in a low lunar orbit, would spend most of a 120-s look-back growing its steps).
+
 It offers the :class:`~odpipe.dynamics.trajectory.Trajectory` interface that
 the measurement models read, with
 
@@ -78,7 +81,7 @@ class SegmentTrajectory:
             x_plus[3:6] += self._dv
         self._fwd = propagate(x_plus, a, b, force_model, with_stm=True, params=list(params), **tol)
         self._back = propagate(self.x_start, a, a - lookback, force_model, with_stm=True,
-                               params=list(params), **tol)
+                               params=list(params), first_step=self._fwd.median_step, **tol)
         self.n_eval = self._fwd.n_eval + self._back.n_eval
         self._memo: dict = {float(a): (self.x_start, np.eye(6), np.eye(6), np.zeros((6, len(self.param_names))))}
 
@@ -87,44 +90,36 @@ class SegmentTrajectory:
         before = t < self.t0
         return t, before
 
-    def _apply(self, t, fn_back, fn_fwd, shape):
+    def _full(self, t) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """(x (N, 6), Phi (N, 6, 6), S (N, 6, p)) at ``t``: one interpolation on each side of ``a``."""
         t, before = self._pieces(t)
-        out = np.empty((t.size,) + shape)
-        if before.any():
-            out[before] = fn_back(t[before])
-        if (~before).any():
-            out[~before] = fn_fwd(t[~before])
-        return out
+        x = np.empty((t.size, 6))
+        Phi = np.empty((t.size, 6, 6))
+        S = np.zeros((t.size, 6, len(self.param_names)))
+        for sel, traj in ((before, self._back), (~before, self._fwd)):
+            if sel.any():
+                x[sel], Phi[sel], S[sel, :, :self._np] = traj.variational(t[sel])
+        after = ~before
+        if self.n_dv and after.any():
+            P = Phi[after]
+            dv_cols = P[:, :, 3:6]
+            if self._dt is not None:
+                dv_cols = dv_cols - self._dt * P[:, :, 0:3]
+                S[after, :, self._np + 3] = -P[:, :, 0:3] @ self._dv
+            S[after, :, self._np:self._np + 3] = dv_cols
+        return x, Phi, S
 
     def state(self, t) -> np.ndarray:
         """Position (m) and velocity (m/s), (N, 6); post-maneuver at ``a``."""
-        return self._apply(t, self._back.state, self._fwd.state, (6,))
+        return self._full(t)[0]
 
     def stm(self, t) -> np.ndarray:
         """d x(t) / d x(a-), (N, 6, 6)."""
-        return self._apply(t, self._back.stm, self._fwd.stm, (6, 6))
+        return self._full(t)[1]
 
     def sensitivity(self, t) -> np.ndarray:
         """d x(t) / d params, (N, 6, p) in ``param_names`` order."""
-        p = len(self.param_names)
-
-        def back(tt):
-            out = np.zeros((tt.size, 6, p))
-            out[:, :, :self._np] = self._back.sensitivity(tt)
-            return out
-
-        def fwd(tt):
-            out = np.zeros((tt.size, 6, p))
-            out[:, :, :self._np] = self._fwd.sensitivity(tt)
-            if self.n_dv:
-                Phi = self._fwd.stm(tt)
-                out[:, :, self._np:self._np + 3] = Phi[:, :, 3:6]
-                if self._dt is not None:
-                    out[:, :, self._np:self._np + 3] -= self._dt * Phi[:, :, 0:3]
-                    out[:, :, self._np + 3] = -Phi[:, :, 0:3] @ self._dv
-            return out
-
-        return self._apply(t, back, fwd, (6, p))
+        return self._full(t)[2]
 
     def at(self, t: float) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
         """(x, Phi, Phi^-1, S) at one epoch, the state at ``a`` taken before its maneuver (Phi = I, S = 0).
@@ -145,7 +140,7 @@ class SegmentTrajectory:
         """Evaluate (x, Phi, Phi^-1, S) at ``epochs`` inside the segment in one vectorized pass."""
         ts = np.asarray([t for t in np.atleast_1d(epochs) if self.t0 < t <= self.t1 and t not in self._memo], float)
         if ts.size:
-            x, Phi, S = self.state(ts), self.stm(ts), self.sensitivity(ts)
+            x, Phi, S = self._full(ts)
             inv = np.linalg.inv(Phi)
             self._memo.update({float(t): (x[i], Phi[i], inv[i], S[i]) for i, t in enumerate(ts)})
 
@@ -171,12 +166,6 @@ class ShiftedSegmentTrajectory(SegmentTrajectory):
         self.n_eval = 0
         self._memo = {self.t0: (self.x_start, np.eye(6), np.eye(6), np.zeros((6, len(self.param_names))))}
 
-    def state(self, t) -> np.ndarray:
-        b = self.base
-        return b.state(t) + b.stm(t) @ self._dx + b.sensitivity(t) @ self._dp
-
-    def stm(self, t) -> np.ndarray:
-        return self.base.stm(t)
-
-    def sensitivity(self, t) -> np.ndarray:
-        return self.base.sensitivity(t)
+    def _full(self, t) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        x, Phi, S = self.base._full(t)
+        return x + Phi @ self._dx + S @ self._dp, Phi, S
