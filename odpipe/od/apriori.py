@@ -14,9 +14,10 @@ the epoch state is found in three steps, all in SI units (m, m/s, s; TDB s past 
    body's PA frame frozen at the epoch. To first order ``y = v . u`` (``u`` towards the
    centre); for one (period, node, inclination) the model ``y = V [cos u0 A1(t) + sin u0 A2(t)]``
    is linear in (cos u0, sin u0), so the argument of latitude at epoch ``u0`` comes out of
-   a 2x2 solve for every grid point at once (numpy, no loop over the phase). Candidates
-   are scored by a trimmed RMS (the worst ``trim`` fraction left out). Rows far off the
-   best candidate are flagged BLUNDER.
+   a 2x2 solve for every grid point (a compiled pass over the rows, no search over the phase).
+   Candidates are scored by a trimmed RMS (the worst ``trim`` fraction left out), computed
+   only where bounds from the untrimmed sum and the largest residual leave a grid point a
+   chance among the best. Rows far off the best candidate are flagged BLUNDER.
 3. **Refinement** of the best distinct candidates through the force model:
    ``scipy.optimize.least_squares`` (soft-L1 loss) on the six epoch-state components with
    the :class:`LineOfSight` model and the STM as Jacobian, the arc growing pass by pass;
@@ -37,6 +38,7 @@ from dataclasses import dataclass, replace
 
 import numpy as np
 import pandas as pd
+from numba import njit
 from scipy.optimize import least_squares
 
 from odpipe.constants import C_LIGHT
@@ -46,6 +48,7 @@ from odpipe.measurements import MeasurementSetup, compute, residuals
 from odpipe.preprocess.compress import compress
 from odpipe.preprocess.edit import EditConfig, edit
 from odpipe.preprocess.flags import Flag, set_flag
+from odpipe.tracking.ramp_segments import store
 from odpipe.tracking.timetags import interval_bounds
 from odpipe.time import utc_to_tdb
 
@@ -79,14 +82,16 @@ class _BodyCentre:
         return np.zeros((np.size(t), 6))
 
 
-def doppler_rows(table: pd.DataFrame, ramps: pd.DataFrame, spacecraft: str, count_time: float = 60.0,
+def doppler_rows(table: pd.DataFrame, ramps, spacecraft: str, count_time: float = 60.0,
                  min_count: float = 30.0) -> pd.DataFrame:
-    """Unflagged 2-way Doppler of ``spacecraft``, blunder-edited and compressed to ``count_time`` (s).
+    """Unflagged 2-way Doppler of ``spacecraft``, blunder-edited and compressed to ``count_time`` (s); ``ramps``:
+    a ramp table or :class:`parsers.ramps.RampStore`.
 
     Windows shorter than ``min_count`` s are left out: a ramp segment or pass start leaves
     one- or few-sample windows whose uplink is often not yet covered by the ramps.
     """
     sel = (table["observable"] == "doppler_2way").to_numpy() & (table["spacecraft"].astype(str) == spacecraft).to_numpy()
+    ramps = store(ramps)  # checked once for the editors and the compression
     # no geometry yet (the orbit is what is sought): no elevation mask
     edited, _ = edit(table[sel].reset_index(drop=True), ramps, EditConfig(min_elevation=-np.inf))
     rows, _ = compress(edited, count_time, ramps=ramps)
@@ -166,30 +171,119 @@ def circular_search(tau, y, u_body, gm: float, periods, raans, inclinations, tri
     tau: s past the epoch (N,); y: m/s (N,); u_body: unit vectors (N,3) in the frozen body
     frame; periods s, raans and inclinations rad (grids). Columns: period, raan, inc,
     arglat (rad, at the epoch), score (trimmed RMS, m/s).
+
+    The trimmed mean square of an orbit lies between (sum - n_trimmed * largest) / n_use and the
+    untrimmed mean square; only orbits whose lower bound is below the ``keep``-th smallest upper
+    bound can be among the ``keep`` best, and only theirs is computed (the others' score is inf).
     """
     ok = np.isfinite(y)
     tau, y, u_body = tau[ok], y[ok], u_body[ok]
     n_use = max(1, int(round((1.0 - trim) * y.size)))
     O, I = (g.ravel() for g in np.meshgrid(raans, inclinations, indexing="ij"))
     P, Q = _plane_axes(O, I)
-    Pu, Qu = P @ u_body.T, Q @ u_body.T  # (K, N)
+    periods = np.atleast_1d(np.asarray(periods, float))
+    n = 2.0 * np.pi / periods
+    Pu, Qu, speed = P @ u_body.T, Q @ u_body.T, (gm * n) ** (1.0 / 3.0)
+    u0, total, largest, solved = _circular_fits(tau, y, Pu, Qu, speed, n)
+    upper = np.where(solved, total / y.size, np.inf)
+    lower = (total - (y.size - n_use) * largest) / n_use
+    bound = np.partition(upper, keep - 1, axis=None)[keep - 1] if upper.size > keep else np.inf
+    score = np.full(u0.shape, np.inf)
+    which = np.flatnonzero(solved & (lower <= bound))
+    score.flat[which] = _trimmed_rms(tau, y, Pu, Qu, speed, n, u0, which, n_use)
     out = []
-    for period in np.atleast_1d(periods):
-        n = 2.0 * np.pi / period
-        V = (gm * n) ** (1.0 / 3.0)  # circular speed, m/s
-        cn, sn = np.cos(n * tau), np.sin(n * tau)
-        A1, A2 = V * (cn * Qu - sn * Pu), -V * (cn * Pu + sn * Qu)
-        a11, a12, a22 = (A1 * A1).sum(1), (A1 * A2).sum(1), (A2 * A2).sum(1)
-        b1, b2 = A1 @ y, A2 @ y
-        det = a11 * a22 - a12 ** 2
-        u0 = np.arctan2(a11 * b2 - a12 * b1, a22 * b1 - a12 * b2)
-        r2 = (y - np.cos(u0)[:, None] * A1 - np.sin(u0)[:, None] * A2) ** 2
-        score = np.sqrt(np.partition(r2, n_use - 1, axis=1)[:, :n_use].mean(1))
-        score[det <= 0] = np.inf
-        best = np.argsort(score)[:keep]
+    for j, period in enumerate(periods):
+        best = np.argsort(score[j])[:keep]
         out.append(pd.DataFrame({"period": period, "raan": O[best], "inc": I[best],
-                                 "arglat": np.mod(u0[best], 2 * np.pi), "score": score[best]}))
+                                 "arglat": np.mod(u0[j, best], 2 * np.pi), "score": score[j, best]}))
     return pd.concat(out, ignore_index=True).sort_values("score", kind="stable").head(keep).reset_index(drop=True)
+
+
+@njit(cache=True)
+def _circular_los(V, cn, sn, p, q):
+    """The two terms (A1, A2) of y = cos(u0) A1 + sin(u0) A2, m/s, for circular speed V at mean anomaly
+    n t (cos, sin) and the line of sight dotted with the node vector (p) and its in-plane normal (q)."""
+    return V * (cn * q - sn * p), -V * (cn * p + sn * q)
+
+
+@njit(cache=True)
+def _circular_fits(tau, y, Pu, Qu, speed, n):
+    """Best phase of circular orbits, M periods (``speed`` m/s, mean motion ``n`` rad/s) by K planes (``Pu``,
+    ``Qu``: (K, N) node and normal-to-node vectors dotted with the N line-of-sight unit vectors): u0 (rad,
+    at tau = 0) from the 2x2 normal equations in (cos u0, sin u0); the sum and the largest of the squared
+    residuals (m2/s2); whether the phase is determined. Each (M, K)."""
+    M, (K, N) = n.size, Pu.shape
+    u0, total, largest = np.empty((M, K)), np.empty((M, K)), np.empty((M, K))
+    solved = np.empty((M, K), np.bool_)
+    cn, sn, A1, A2 = np.empty(N), np.empty(N), np.empty(N), np.empty(N)
+    for m in range(M):
+        for i in range(N):  # scalar loops: array expressions would triple the compile time
+            cn[i], sn[i] = np.cos(n[m] * tau[i]), np.sin(n[m] * tau[i])
+        for k in range(K):
+            a11 = a12 = a22 = b1 = b2 = 0.0
+            for i in range(N):
+                A1[i], A2[i] = _circular_los(speed[m], cn[i], sn[i], Pu[k, i], Qu[k, i])
+                a11 += A1[i] * A1[i]
+                a12 += A1[i] * A2[i]
+                a22 += A2[i] * A2[i]
+                b1 += A1[i] * y[i]
+                b2 += A2[i] * y[i]
+            u = np.arctan2(a11 * b2 - a12 * b1, a22 * b1 - a12 * b2)
+            c, s = np.cos(u), np.sin(u)
+            sq, top = 0.0, 0.0
+            for i in range(N):
+                r2 = (y[i] - c * A1[i] - s * A2[i]) ** 2
+                sq += r2
+                top = max(top, r2)
+            u0[m, k], total[m, k], largest[m, k], solved[m, k] = u, sq, top, a11 * a22 - a12 ** 2 > 0.0
+    return u0, total, largest, solved
+
+
+@njit(cache=True)
+def _trimmed_rms(tau, y, Pu, Qu, speed, n, u0, which, n_use):
+    """RMS (m/s) of the ``n_use`` smallest residuals of the circular orbits at flat indices ``which`` of
+    :func:`_circular_fits`' (M, K) arrays."""
+    K, N = Pu.shape
+    cn, sn = np.empty((n.size, N)), np.empty((n.size, N))
+    for m in range(n.size):
+        for i in range(N):
+            cn[m, i], sn[m, i] = np.cos(n[m] * tau[i]), np.sin(n[m] * tau[i])
+    out, r2 = np.empty(which.size), np.empty(N)
+    for j in range(which.size):
+        m, k = which[j] // K, which[j] % K
+        c, s = np.cos(u0[m, k]), np.sin(u0[m, k])
+        for i in range(N):
+            A1, A2 = _circular_los(speed[m], cn[m, i], sn[m, i], Pu[k, i], Qu[k, i])
+            r2[i] = (y[i] - c * A1 - s * A2) ** 2
+        out[j] = np.sqrt(_smallest_mean(r2, n_use))
+    return out
+
+
+@njit(cache=True)
+def _smallest_mean(v, count: int) -> float:
+    """Mean of the ``count`` smallest values of ``v`` (reordered in place: quickselect, median-of-three pivot;
+    compiles in a fraction of the time of numba's ``np.partition``)."""
+    lo, hi, kth = 0, v.size - 1, count - 1
+    while lo < hi:
+        a, b, c = v[lo], v[(lo + hi) // 2], v[hi]
+        pivot = max(min(a, b), min(max(a, b), c))
+        i, j = lo, hi
+        while i <= j:
+            while v[i] < pivot:
+                i += 1
+            while v[j] > pivot:
+                j -= 1
+            if i <= j:
+                v[i], v[j] = v[j], v[i]
+                i += 1
+                j -= 1
+        if kth <= j:
+            hi = j
+        elif kth >= i:
+            lo = i
+        else:
+            break
+    return v[:count].mean()
 
 
 def circular_los(tau, u_body, gm: float, period: float, raan: float, inc: float, arglat: float) -> np.ndarray:
