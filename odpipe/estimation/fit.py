@@ -14,8 +14,8 @@ registry coordinates (the full parameter vector, state and parameters alike):
   reference holds (J >= 1: references at J + 1 epochs, J transitions, the rows
   ``bounds[0]:bounds[J]``), answered at once instead of interval by interval;
 * optionally ``set_coarse(on)``: the fit turns it on for the passes of its loose-weight
-  stages (all but the last ``sigma_scale``) and for the first pass of the last stage (which
-  edits nothing), whose references need not be exact (they only bring the reference near
+  stages (all but the last ``sigma_scale``) and for the first pass of the last stage (whose
+  edits the next, exact pass decides again), whose references need not be exact (they only bring the reference near
   the solution), and off for the other passes of the last stage and once the iterations
   end; a fit never ends converged on a coarse pass.
 
@@ -98,7 +98,8 @@ class FitOptions:
     sigma_scale: data-weight stages multiplying every sigma, loose to tight (e.g. (30, 5, 1)):
     a far-off reference is first fitted with loose weights; the next stage starts once the
     epoch correction is below stage_tol sigma, inside the tight fit's linear regime, and its
-    first pass edits nothing. max_halvings: when the models cannot be evaluated about a
+    first pass edits as the schedule says (gated by edit_gate_rms in the new stage's units).
+    max_halvings: when the models cannot be evaluated about a
     corrected reference (an orbit driven into the central body), the correction is halved
     up to this many times before FitDiverged, which is also raised when the iterations end
     unconverged with the post-fit RMS above diverged_rms sigma and above its best iteration's.
@@ -337,7 +338,7 @@ def fit(problem: Problem, obs: Observations, t_start: float, t_end: float,
         coarse_pass = stage < last_stage or stage_start
         coarse(coarse_pass)
         sig_row = obs.sigma * np.array([scale[g] for g in obs.group]) * options.sigma_scale[stage]
-        kk = np.inf if stage_start else _edit_k(options, it, prev_rms)  # a new stage's first pass edits nothing
+        kk = _edit_k(options, it, prev_rms)  # a new stage's first pass edits too: rows let back in pull it off
         stage_start = False
         for halving in range(options.max_halvings + 1):
             try:
