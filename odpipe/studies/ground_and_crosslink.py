@@ -30,7 +30,6 @@ thesis' EKF: RMS over days 6-9 of the 3-D position error and of the 3-D 3-sigma 
 from __future__ import annotations
 
 import json
-from dataclasses import replace
 from pathlib import Path
 
 import numpy as np
@@ -45,8 +44,6 @@ from odpipe.estimation.fit import FitOptions, Observations, build_grid, fit
 from odpipe.estimation.registry import ParameterRegistry
 from odpipe.frames.earth import itrs_to_gcrs_state
 from odpipe.measurements import MeasurementSetup, compute
-from odpipe.frames.tabulated import TabulatedRotation
-from odpipe.measurements.compute import SPAN_MARGIN_S
 from odpipe.od.problem import TrackingProblem
 from odpipe.simulate.schedule import StateOnly, elevation
 from odpipe.time import utc_to_tdb
@@ -386,9 +383,6 @@ def prepare(cfg: dict, log=print) -> dict:
     rows = observe(cfg, tracking_rows(cfg, truth, setup, start), rng)
     guess = initial_guess(cfg, x0, rng)
     log(f"truth and {len(rows)} candidate rows; biases {rows.attrs['bias']}")
-    # the Earth orientation tabulated once for the arc, not at every segment and iteration of every fit (a table on
-    # whole hours: the same values)
-    setup = replace(setup, gcrs_to_itrs=TabulatedRotation(setup.gcrs_to_itrs, t0 - SPAN_MARGIN_S, t1 + SPAN_MARGIN_S))
     return {"setup": setup, "t0": t0, "t1": t1, "x0": x0, "truth": truth, "rows": rows, "guess": guess,
             "fm": force_models(cfg, setup.ephemeris, "filter")}
 
