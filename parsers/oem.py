@@ -10,6 +10,7 @@ unreadable ephemeris line is left out and added to the report; other faults
 
 from __future__ import annotations
 
+import math
 import re
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -52,13 +53,11 @@ def read(path, errors: str = "raise", report: ParseReport | None = None) -> list
             raise ParseError(path, "segment without ephemeris data lines", line=lineno)
         if len(cov_rows) != len(cov_epochs):
             raise ParseError(path, f"{len(cov_epochs)} covariance EPOCHs for {len(cov_rows)} matrices", line=lineno)
-        good = [(e, x) for e, x in (_state(path, n, r, errors, report) for n, r in rows) if e is not None]
-        epochs = np.array([e for e, _ in good], dtype="datetime64[ns]")
-        states = np.array([x for _, x in good]).reshape(-1, 6) * _SCALE
+        epochs, states = _states(path, rows, errors, report)
+        states = states * _SCALE
         covs = np.zeros((len(cov_rows), 6, 6))
-        for k, (n, vals) in enumerate(cov_rows):
-            covs[k][_TRIL] = vals
-            covs[k] = covs[k] + np.tril(covs[k], -1).T
+        covs[:, _TRIL[0], _TRIL[1]] = np.reshape([vals for _, vals in cov_rows], (-1, 21))
+        covs = covs + np.tril(covs, -1).transpose(0, 2, 1)
         segments.append(OemSegment(meta, epochs, states, np.array(cov_epochs, dtype="datetime64[ns]"),
                                    covs * _SCALE**2))
 
@@ -95,7 +94,7 @@ def read(path, errors: str = "raise", report: ParseReport | None = None) -> list
                 raise ParseError(path, f"ephemeris line needs 7 or 10 fields, got {len(fields)}", line=lineno)
             rows.append((lineno, fields))
         elif state == "cov":
-            cov_vals += [_number(path, lineno, v) for v in text.split()]
+            cov_vals += _numbers(path, lineno, text.split())
             if len(cov_vals) > 21:
                 raise ParseError(path, "covariance has more than 21 lower-triangle numbers", line=lineno)
             if len(cov_vals) == 21:
@@ -105,6 +104,22 @@ def read(path, errors: str = "raise", report: ParseReport | None = None) -> list
     if not segments:
         raise ParseError(path, "no META_START block", line=len(lines))
     return segments
+
+
+def _states(path, rows, errors, report):
+    """Epochs and states (km, km/s) of a segment's ephemeris lines [(lineno, fields)]: converted as one block
+    when every line is clean (the same values), else line by line, each fault raised or reported."""
+    texts = [f[0] for _, f in rows]
+    if all(_EPOCH.fullmatch(t) and 1678 <= int(t[:4]) <= 2261 for t in texts):
+        try:
+            epochs = np.array([t.rstrip("Z") for t in texts], dtype="datetime64[ns]")
+            states = np.array([f[1:7] for _, f in rows], dtype=float)
+            if np.isfinite(states).all():
+                return epochs, states
+        except ValueError:
+            pass
+    good = [(e, x) for e, x in (_state(path, n, r, errors, report) for n, r in rows) if e is not None]
+    return np.array([e for e, _ in good], dtype="datetime64[ns]"), np.array([x for _, x in good]).reshape(-1, 6)
 
 
 def _state(path, lineno, fields, errors, report):
@@ -128,6 +143,17 @@ def _epoch(path, lineno, text):
         return np.datetime64(text.rstrip("Z"), "ns")
     except ValueError:
         raise ParseError(path, f"bad epoch {text[:40]!r}", line=lineno) from None
+
+
+def _numbers(path, lineno, texts) -> list[float]:
+    """The numbers of one line: converted at once, or one by one to name a bad one."""
+    try:
+        values = [float(t) for t in texts]
+        if all(map(math.isfinite, values)):
+            return values
+    except ValueError:
+        pass
+    return [_number(path, lineno, t) for t in texts]
 
 
 def _number(path, lineno, text):

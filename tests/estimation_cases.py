@@ -52,30 +52,23 @@ class LinearProblem:
 
 @njit(cache=True)
 def _twobody_deriv(y, p, out):
-    """y = [r, v, S(6 x k) row-major]; p = [mu, ax, ay, az]; S columns: x0 then acc."""
-    r = y[0:3]
-    rn = np.sqrt(r[0] ** 2 + r[1] ** 2 + r[2] ** 2)
+    """y = [r, v, S(6 x k) row-major]; p = [mu, ax, ay, az]; S columns: x0 then acc. Writes dy/dt into ``out``
+    without allocating (the kernel runs four times per RK4 step)."""
     mu = p[0]
-    out[0:3] = y[3:6]
-    out[3:6] = -mu * r / rn**3 + p[1:4]
-    G = np.empty((3, 3))
+    rn = np.sqrt(y[0] ** 2 + y[1] ** 2 + y[2] ** 2)
+    rn3, rn5 = rn**3, rn**5
     for i in range(3):
-        for j in range(3):
-            G[i, j] = 3 * mu * r[i] * r[j] / rn**5 - (mu / rn**3 if i == j else 0.0)
-    _variational(y, G, out)
-
-
-@njit(cache=True)
-def _variational(y, G, out):
-    """d/dt S = [[0, I], [G, 0]] S + [0; I] on the acceleration columns (last three)."""
+        out[i] = y[3 + i]
+        out[3 + i] = -mu * y[i] / rn3 + p[1 + i]
     k = (y.size - 6) // 6
-    S = y[6:].reshape(6, k)
-    D = np.zeros((6, k))
-    D[0:3] = S[3:6]
-    D[3:6] = G @ S[0:3]
-    for i in range(3):
-        D[3 + i, k - 3 + i] += 1.0
-    out[6:] = D.ravel()
+    for c in range(k):          # d/dt S = [[0, I], [G, 0]] S + [0; I] on the acceleration columns (last three)
+        for i in range(3):
+            out[6 + i * k + c] = y[6 + (3 + i) * k + c]
+            g = 0.0
+            for j in range(3):
+                G = 3 * mu * y[i] * y[j] / rn5 - (mu / rn3 if i == j else 0.0)
+                g += G * y[6 + j * k + c]
+            out[6 + (3 + i) * k + c] = g + (1.0 if c == k - 3 + i else 0.0)
 
 
 @njit(cache=True)
@@ -84,18 +77,23 @@ def _rk4(y0, t0, times, h, p):
     out = np.empty((times.size, y0.size))
     y = y0.copy()
     t = t0
-    k1 = np.empty_like(y0)
-    k2 = np.empty_like(y0)
-    k3 = np.empty_like(y0)
-    k4 = np.empty_like(y0)
+    k = np.empty((5, y0.size))
+    k1, k2, k3, k4, w = k[0], k[1], k[2], k[3], k[4]
     for i in range(times.size):
         while t < times[i]:
             dt = min(h, times[i] - t)
             _twobody_deriv(y, p, k1)
-            _twobody_deriv(y + 0.5 * dt * k1, p, k2)
-            _twobody_deriv(y + 0.5 * dt * k2, p, k3)
-            _twobody_deriv(y + dt * k3, p, k4)
-            y = y + dt / 6 * (k1 + 2 * k2 + 2 * k3 + k4)
+            for n in range(y.size):
+                w[n] = y[n] + 0.5 * dt * k1[n]
+            _twobody_deriv(w, p, k2)
+            for n in range(y.size):
+                w[n] = y[n] + 0.5 * dt * k2[n]
+            _twobody_deriv(w, p, k3)
+            for n in range(y.size):
+                w[n] = y[n] + dt * k3[n]
+            _twobody_deriv(w, p, k4)
+            for n in range(y.size):
+                y[n] = y[n] + dt / 6 * (k1[n] + 2 * k2[n] + 2 * k3[n] + k4[n])
             t += dt
         out[i] = y
     return out

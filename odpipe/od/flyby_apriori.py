@@ -79,11 +79,30 @@ def sphere_grid(step_deg: float) -> np.ndarray:
 def radial_los(los: LineOfSight, t_p: float, mu: float, sides: np.ndarray, v_inf: float) -> np.ndarray:
     """Modelled y (K, N) m/s of the radial approaches from ``sides`` (K,3) at speed ``v_inf`` (m/s at infinity)
     reaching the centre at ``t_p``: ``|p + s rho|`` is ``sqrt(|p|² + 2 rho s.p + rho²)``."""
-    rho0, rho1 = radial_distance(t_p - los.t0, mu, v_inf), radial_distance(t_p - los.t1, mu, v_inf)
-    n0 = np.sqrt(np.sum(los.p0 ** 2, 1) + 2 * rho0 * (sides @ los.p0.T) + rho0 ** 2)
-    n1 = np.sqrt(np.sum(los.p1 ** 2, 1) + 2 * rho1 * (sides @ los.p1.T) + rho1 ** 2)
-    base = np.linalg.norm(los.p1, axis=1) - np.linalg.norm(los.p0, axis=1)
-    return (n1 - n0 - base) / (los.t1 - los.t0)
+    return _los_of_sides(los, _distances(los, t_p, mu, v_inf), sides @ los.p0.T, sides @ los.p1.T)
+
+
+def _distances(los: LineOfSight, t_p: float, mu: float, v_inf: float) -> tuple:
+    """(rho0, rho1): the radial hyperbola's distances (m) at the count starts and ends of ``los``."""
+    return radial_distance(t_p - los.t0, mu, v_inf), radial_distance(t_p - los.t1, mu, v_inf)
+
+
+def _los_of_sides(los: LineOfSight, rho, sp0: np.ndarray, sp1: np.ndarray) -> np.ndarray:
+    """:func:`radial_los` from the distances ``rho`` = (rho0, rho1) (N,) and the products s.p0, s.p1 (K, N); the
+    products are overwritten (in place: the search's arrays are large)."""
+    rho0, rho1 = rho
+    for sp, p, r in ((sp0, los.p0, rho0), (sp1, los.p1, rho1)):
+        sp *= 2 * r
+        sp += np.sum(p ** 2, 1)
+        sp += r ** 2
+        np.sqrt(sp, out=sp)
+    sp1 -= sp0
+    sp1 -= np.linalg.norm(los.p1, axis=1) - np.linalg.norm(los.p0, axis=1)
+    sp1 /= los.t1 - los.t0
+    return sp1
+
+
+_SEARCH_CELLS = 1 << 16   # (side, row) cells per block of the asymptote search
 
 
 def _usable(los: LineOfSight, t_p: float) -> LineOfSight:
@@ -98,10 +117,17 @@ def asymptote_search(los: LineOfSight, t_p: float, mu: float, sides: np.ndarray,
     The score changes by m/s within a degree: polish the best (:func:`polish_approach`)."""
     los = _usable(los, t_p)
     n_use = max(1, int(round((1.0 - trim) * los.y.size)))
+    chunk = max(1, _SEARCH_CELLS // max(1, los.y.size))       # sides per block: its (K, N) arrays stay in cache
+    blocks = [(sides[k:k + chunk] @ los.p0.T, sides[k:k + chunk] @ los.p1.T) for k in range(0, len(sides), chunk)]
     out = []
     for v in np.atleast_1d(speeds):
-        r2 = (radial_los(los, t_p, mu, sides, float(v)) - los.y) ** 2
-        score = np.sqrt(np.partition(r2, n_use - 1, axis=1)[:, :n_use].mean(1))
+        rho = _distances(los, t_p, mu, float(v))
+        score = np.empty(len(sides))
+        for k, (sp0, sp1) in zip(range(0, len(sides), chunk), blocks):
+            r2 = _los_of_sides(los, rho, sp0.copy(), sp1.copy())
+            r2 -= los.y
+            r2 **= 2
+            score[k:k + chunk] = np.sqrt(np.partition(r2, n_use - 1, axis=1)[:, :n_use].mean(1))
         out.append(pd.DataFrame({"sx": sides[:, 0], "sy": sides[:, 1], "sz": sides[:, 2], "v_inf": float(v),
                                  "score": score}))
     return pd.concat(out, ignore_index=True).sort_values("score", kind="stable").head(keep).reset_index(drop=True)
@@ -116,9 +142,17 @@ def polish_approach(los: LineOfSight, t_p: float, mu: float, side, v_inf: float,
     def unit(a):
         return np.array([np.cos(a[1]) * np.cos(a[0]), np.cos(a[1]) * np.sin(a[0]), np.sin(a[1])])
 
+    rho = {}   # speed -> (rho0, rho1): the Jacobian's steps in the two angles keep the speed
+
+    def residual(a):
+        v = a[2] * 1e3
+        if v not in rho:
+            rho[v] = _distances(los, t_p, mu, v)
+        side = unit(a)[None, :]
+        return _los_of_sides(los, rho[v], side @ los.p0.T, side @ los.p1.T)[0] - los.y
+
     a0 = np.array([np.arctan2(s[1], s[0]), np.arcsin(np.clip(s[2], -1, 1)), v_inf / 1e3])
-    fit = least_squares(lambda a: radial_los(los, t_p, mu, unit(a)[None, :], a[2] * 1e3)[0] - los.y, a0,
-                        loss="soft_l1", f_scale=loss_scale, diff_step=1e-7)
+    fit = least_squares(residual, a0, loss="soft_l1", f_scale=loss_scale, diff_step=1e-7)
     return unit(fit.x), float(fit.x[2] * 1e3)
 
 

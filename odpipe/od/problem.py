@@ -56,8 +56,9 @@ import numpy as np
 import pandas as pd
 
 from odpipe.dynamics.forces import EmpiricalRTN, ForceModel
+from odpipe.frames.tabulated import TabulatedRotation
 from odpipe.measurements import MeasurementSetup, compute, residuals
-from odpipe.measurements.compute import prepare
+from odpipe.measurements.compute import SPAN_MARGIN_S, prepare
 from odpipe.measurements.timetag import tag_rate
 
 from .segment import SegmentTrajectory, ShiftedSegmentTrajectory
@@ -121,6 +122,7 @@ class TrackingProblem:
         if np.any(np.diff(self.times) < 0):
             raise ValueError("rows must be ordered by time")
         self.force_models, self.setup = dict(force_models), setup
+        self._tabulated = None      # setup with the Earth orientation tabulated over the problem (first use)
         self.t_start, self.t_end = float(t_start), float(t_end)
         self.lookback, self.rtol, self.atol = lookback, rtol, atol
         self.integrator = dict(integrator or {})
@@ -291,6 +293,18 @@ class TrackingProblem:
         self._segments.sort(key=lambda s: s.a)
         return seg
 
+    def _arc_setup(self) -> MeasurementSetup:
+        """``setup`` with the GCRS->ITRS rotation tabulated once over the problem's span and rows (compute()'s margin),
+        instead of at every compute() call (every segment and iteration); the table's hourly segments are fitted
+        on the same nodes either way, so the values are the same."""
+        if self._tabulated is None:
+            rot = self.setup.gcrs_to_itrs
+            if rot is not None and not isinstance(rot, TabulatedRotation):
+                t = np.r_[self.t_start - self.lookback, self.t_end, self.times[:1], self.times[-1:]]
+                rot = TabulatedRotation(rot, t.min() - SPAN_MARGIN_S, t.max() + SPAN_MARGIN_S)
+            self._tabulated = replace(self.setup, gcrs_to_itrs=rot)
+        return self._tabulated
+
     def _measurement_setup(self, x0) -> MeasurementSetup:
         """The measurement set-up with every estimated oscillator's terms from ``x0``."""
         osc = dict(self.setup.oscillators)
@@ -300,7 +314,7 @@ class TrackingProblem:
                 terms[2] = p.info.get("t_ref", terms[2])
                 terms[("y0", "y1").index(p.info["oscillator"])] = x0[i]
                 osc[p.owner] = tuple(terms)
-        return replace(self.setup, oscillators=osc)
+        return replace(self._arc_setup(), oscillators=osc)
 
     def _evaluate(self, lo, hi, trajs, x0):
         n, m = len(self.registry), hi - lo
