@@ -1,5 +1,7 @@
 """Data-weight stages and step halving of the iterated filter-smoother (two-body arc with simulated truth)."""
 
+from dataclasses import replace
+
 import numpy as np
 import pytest
 
@@ -74,3 +76,20 @@ def test_a_fit_made_worse_by_its_iterations_raises_instead_of_returning_products
     prob, obs, _, _ = case
     with pytest.raises(FitDiverged, match="not converged in 3 iterations"):
         fit(_Worsening(prob, obs.sigma), obs, 0.0, DAY, FitOptions(block=600.0, max_iter=3, edit_k=(np.inf,)))
+
+
+def test_a_new_stages_first_pass_keeps_a_blunder_edited(case):
+    """Rows the last stage edited are tested again at the next stage's first pass, not let back in: a 30-sigma
+    blunder (at the tight weight) stays out of every pass once edited, and the stages end on the plain fit's
+    solution without it."""
+    prob, obs, truth, plain = case
+    value = obs.value.copy()
+    value[len(value) // 2] += 30.0 * obs.sigma[len(value) // 2]
+    bad = replace(obs, value=value)
+    staged = fit(prob, bad, 0.0, DAY, FitOptions(block=600.0, sigma_scale=(100.0, 10.0, 1.0), max_iter=15,
+                                                 edit_k=(np.inf, 10.0, 5.0)))
+    assert staged.converged
+    edited = [h["edited"] for h in staged.history]
+    first = next(i for i, h in enumerate(staged.history) if h["sigma_scale"] == 1.0)
+    assert edited[first] == 1 and edited[-1] == 1   # the new stage's first pass too (it let it back in: 0)
+    assert np.max(np.abs(staged.x0 - plain.x0) / np.sqrt(np.diag(plain.P0))) < 0.05
