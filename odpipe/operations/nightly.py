@@ -93,6 +93,15 @@ def dependency_order(configs: list[str], after: dict) -> list[str]:
     return order
 
 
+def chain_lengths(configs: list[str], sources: dict) -> dict[str, int]:
+    """Per arc, the number of arcs in the longest chain that starts with it (itself and those that start from
+    it, directly or not): the arc that leads the longest chain runs first when workers are scarce."""
+    length: dict[str, int] = {}
+    for c in reversed(configs):   # dependency order reversed: every arc after those that start from it
+        length[c] = 1 + max((length[d] for d in configs if c in sources.get(d, ())), default=0)
+    return length
+
+
 def _local_cluster(workers: int):
     """``workers`` single-threaded worker processes on any free port (never clashing with a running cluster),
     with glibc's own heap trimming: Dask's default ``MALLOC_TRIM_THRESHOLD_`` of 64 kB also fixes glibc's mmap
@@ -117,7 +126,8 @@ def run_batch(configs, run_one: Callable[[Path], dict], *, after: dict | None = 
               failed: dict | None = None, warm: Callable[[list], None] | None = None) -> list[ArcOutcome]:
     """Run every arc config; returns one outcome per arc in completion order.
 
-    ``after``: config -> configs whose products it starts from (run first). ``scheduler``
+    ``after``: config -> configs whose products it starts from (run first: an arc is sent to the cluster once
+    they are done, so it goes to whichever worker is free, the arc leading the longest chain first). ``scheduler``
     is the address of a running Dask scheduler; without it a local cluster of ``workers``
     single-threaded processes is started (and closed in the background once every arc is
     done, while the caller goes on: its workers take seconds to exit). ``failed``: config ->
@@ -139,20 +149,32 @@ def run_batch(configs, run_one: Callable[[Path], dict], *, after: dict | None = 
     if not configs:
         return outcomes
     cluster = None if scheduler else _local_cluster(workers)
+    inside = set(configs)
+    sources = {c: [d for d in after.get(c, ()) if d in broken or d in inside] for c in configs}
+    rank = chain_lengths(configs, sources)
+    done = dict(broken)
+    waiting = list(configs)
     with Client(scheduler or cluster) as client:
-        futures = {}
-        for i, c in enumerate(configs):
-            deps = [broken[d] if d in broken else futures[d] for d in after.get(c, ()) if d in broken or d in futures]
-            futures[c] = client.submit(_guarded, run_one, c, *deps, key=f"arc-{i}", pure=False)
+        running = as_completed()
+
+        def submit_ready():   # an arc is sent once its sources are done, to whichever worker is free
+            for c in [c for c in waiting if all(d in done for d in sources[c])]:
+                waiting.remove(c)
+                running.add(client.submit(_guarded, run_one, c, *[done[d] for d in sources[c]],
+                                          key=f"arc-{configs.index(c)}", priority=rank[c], pure=False))
+
+        submit_ready()
         if warm is not None:   # after the arcs: a worker given the first arc runs this only when idle
             for k, address in enumerate(client.scheduler_info()["workers"]):
                 client.submit(_warmed, warm, configs, key=f"warm-{k}", workers=[address],
                               allow_other_workers=False, priority=-1, pure=False)
-        for fut in as_completed(list(futures.values())):
+        for fut in running:
             out = fut.result()
+            done[out.config] = out
             outcomes.append(out)
             note = f": {out.error}" if out.error else ""
             progress(f"[{len(outcomes)}/{total}] {Path(out.config).name}: {out.status} in {out.seconds:.1f} s{note}")
+            submit_ready()
     if cluster is not None:   # the caller's summary and report need no worker
         threading.Thread(target=cluster.close, name="close the local Dask cluster").start()
     return outcomes
