@@ -29,15 +29,21 @@ GM_EARTH = 3.986004415e14  # m^3/s^2
 
 def other_kernels() -> None:
     """One call of each kernel signature outside the demo: RK4 through the compiled force model
-    (one type for every model), ``crtbp_rhs`` on writable arrays (``studies.crtbp_orbits``) and
-    ``gtd7`` on writable arrays (drag and direct calls differ in array mutability)."""
+    (one type for every model), ``crtbp_rhs`` on writable arrays (``studies.crtbp_orbits``),
+    ``gtd7`` on writable arrays (drag and direct calls differ in array mutability) and the a priori
+    orbit search's grid kernels (``od.apriori.circular_search``, about 6 s to compile)."""
     from odpipe.dynamics.crtbp import crtbp_rhs
     from odpipe.environment.atmosphere.nrlmsise00 import gtd7
+    from odpipe.od.apriori import circular_search
 
     x0 = np.array([7.0e6, 0.0, 0.0, 0.0, 7.5e3, 0.0])
     propagate(x0, 0.0, 120.0, ForceModel("earth", central_gm=GM_EARTH), with_stm=True, method="rk4", max_step=60.0)
     crtbp_rhs(0.0, np.array([0.82, 0.0, 0.1, 0.0, 0.2, 0.0]), np.array([0.0121]), np.empty(6))
     gtd7(172, 29000.0, 400.0, 60.0, -70.0, 16.0, 150.0, 150.0, 4.0)
+    tau = np.linspace(0.0, 3600.0, 12)
+    u = np.tile([0.6, 0.0, 0.8], (tau.size, 1))
+    circular_search(tau, np.sin(tau / 1000.0), u, 4.9e12, [6800.0], np.radians([0.0, 90.0]), np.radians([85.0, 90.0]),
+                    keep=2)
 
 
 def warm_worker(configs: list) -> None:
