@@ -112,13 +112,18 @@ def case_libration(eph):
     print("    distance from the Moon [1000 km] on days 0..14: " + " ".join(f"{d / 1e3:.0f}" for d in d_moon))
 
 
-def case_low_lunar(eph):
-    t0 = float(utc_to_tdb(np.datetime64("2012-04-08T00:00:00"))[()])
+def low_lunar_orbit(utc: str):
+    """(TDB s, the lpe200 field, a circular 55-km orbit inclined 89 deg at that epoch: m, m/s)."""
     lpe = read_gravity(DATA / "gravity/tudat/lpe200.txt")
     r = lpe.radius + 55e3
     v = np.sqrt(lpe.gm / r)
     inc = np.radians(89.0)
-    x0 = np.array([r, 0.0, 0.0, 0.0, v * np.cos(inc), v * np.sin(inc)])
+    return float(utc_to_tdb(np.datetime64(utc))[()]), lpe, np.array([r, 0.0, 0.0, 0.0, v * np.cos(inc),
+                                                                     v * np.sin(inc)])
+
+
+def case_low_lunar(eph):
+    t0, lpe, x0 = low_lunar_orbit("2012-04-08T00:00:00")
     print("(c) 1 day, 55-km polar lunar orbit, Moon 200x200, Earth+Sun, STM")
     for partial in (50, 8):   # 8: the GRAIL nightly's partial_degree
         fm = ForceModel("moon", [SphericalHarmonics("moon", lpe, 200, partial_degree=partial),
@@ -129,12 +134,7 @@ def case_low_lunar(eph):
 
 
 def case_grail_segments(eph):
-    t0 = float(utc_to_tdb(np.datetime64("2012-04-10T04:00:00"))[()])
-    lpe = read_gravity(DATA / "gravity/tudat/lpe200.txt")
-    r = lpe.radius + 55e3
-    v = np.sqrt(lpe.gm / r)
-    inc = np.radians(89.0)
-    x = np.array([r, 0.0, 0.0, 0.0, v * np.cos(inc), v * np.sin(inc)])
+    t0, lpe, x = low_lunar_orbit("2012-04-10T04:00:00")
     base = [SphericalHarmonics("moon", lpe, 150, partial_degree=8), PointMasses(["earth", "sun"]),
             SolarRadiationPressure(cr_area=5.0)]
     params = ["srp_scale", "emp[0].R", "emp[0].T", "emp[0].N"]
