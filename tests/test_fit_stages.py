@@ -93,3 +93,27 @@ def test_a_new_stages_first_pass_keeps_a_blunder_edited(case):
     first = next(i for i, h in enumerate(staged.history) if h["sigma_scale"] == 1.0)
     assert edited[first] == 1 and edited[-1] == 1   # the new stage's first pass too (it let it back in: 0)
     assert np.max(np.abs(staged.x0 - plain.x0) / np.sqrt(np.diag(plain.P0))) < 0.05
+
+
+class _SpansNothing:
+    """The problem, with a ``span`` that answers no interval (a reference segment ending before the next grid
+    epoch): the fit must stop with a reason instead of sweeping forever."""
+
+    def __init__(self, problem):
+        self.problem, self.registry = problem, problem.registry
+
+    def span(self, epochs, x0, bounds):
+        n = x0.size
+        return x0[None, :], np.empty((0, n, n)), np.empty(0), np.empty((0, n))
+
+    def transition(self, t0, t1, x0):
+        return self.problem.transition(t0, t1, x0)
+
+    def predict(self, t0, x0, rows):
+        return self.problem.predict(t0, x0, rows)
+
+
+def test_a_span_that_answers_no_interval_stops_the_fit_with_a_reason(case):
+    prob, obs, _, _ = case
+    with pytest.raises(FitDiverged, match="span answered no grid interval from 0.000 s TDB"):
+        fit(_SpansNothing(prob), obs, 0.0, DAY, FitOptions(block=600.0, max_iter=2))

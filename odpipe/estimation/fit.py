@@ -229,6 +229,8 @@ def _sweep(problem, grid, steps, bounds, x_ref0, p_after) -> _Sweep:
             end = next((e for e in sorted(steps) if e > k), K)
             xs, Phi_k, c, H_k = span(grid[k:end + 1], xr, bounds[k:end + 1])
             j = Phi_k.shape[0]
+            if j == 0:   # the sweep would never advance
+                raise RuntimeError(f"the problem's span answered no grid interval from {grid[k]:.3f} s TDB")
             refs.extend(xs[:-1])
             Phi[k:k + j] = Phi_k
             hi = bounds[k + j] - lo0
