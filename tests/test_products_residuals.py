@@ -100,7 +100,9 @@ def test_a_mean_that_rounds_to_zero_has_no_sign(res):
 
 @pytest.mark.parametrize("value, text", [(4516.098, "4520"), (0.52062, "0.521"), (12.0, "12.0"),
                                          (-0.0124, "-0.0124"), (0.999999, "1.00"),
-                                         (0.52999, "0.530"), (9.9996, "10.0"), (0.0, "0.00")])
+                                         (0.52999, "0.530"), (9.9996, "10.0"), (0.0, "0.00"),
+                                         (0.73, "0.730"), (0.5, "0.500"), (0.073, "0.0730"),
+                                         (-0.73, "-0.730")])
 def test_significant_figures(value, text):
     assert significant(value) == text
 

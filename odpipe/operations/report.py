@@ -58,8 +58,10 @@ def significant(value: float, digits: int = 3) -> str:
     """``value`` to ``digits`` significant figures in positional notation, trailing zeros kept
     (4516.098 → "4520", 0.52062 → "0.521", 12 → "12.0"): a statistic at the precision it carries."""
     rounded = float(f"{float(value):.{digits}g}")   # first, so a carry (0.52999 → 0.530) keeps its zeros
-    return np.format_float_positional(rounded, precision=digits, unique=False, fractional=False,
-                                      trim="k").rstrip(".")
+    if not np.isfinite(rounded):
+        return str(rounded)
+    exponent = int(np.floor(np.log10(abs(rounded)))) if rounded else 0
+    return f"{rounded:.{max(0, digits - 1 - exponent)}f}"   # numpy's positional format gave 0.73 → "0.73"
 
 
 def decimals(step: float) -> int:
