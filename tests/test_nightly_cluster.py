@@ -1,6 +1,7 @@
 """The nightly's local Dask cluster: its workers' environment, warm-up and how chained arcs are placed."""
 
 import os
+import threading
 import time
 
 from odpipe.operations.nightly import _local_cluster, chain_lengths, run_batch
@@ -44,10 +45,16 @@ def _timed(path):
 
 def test_two_arcs_from_one_source_run_at_once_on_two_workers():
     """GRAIL's nightly: 04-08 and 04-10 both start from 04-09. Sent with 04-09's outcome as a Dask dependency
-    they both went to 04-09's worker, and 04-10 waited 2 s for work stealing; each now goes to a free worker."""
+    they both went to 04-09's worker, and 04-10 waited 2 s for work stealing; each now goes to a free worker.
+    Work stealing is off here, so only where an arc is sent decides where it runs."""
+    import dask
+
     after = {"b.toml": ["a.toml"], "c.toml": ["a.toml"], "d.toml": ["c.toml"]}
-    out = {o.config: o.detail for o in run_batch(["a.toml", "b.toml", "c.toml", "d.toml"], _timed, after=after,
-                                                 workers=2, progress=lambda s: None)}
+    with dask.config.set({"distributed.scheduler.work-stealing": False}):
+        out = {o.config: o.detail for o in run_batch(["a.toml", "b.toml", "c.toml", "d.toml"], _timed, after=after,
+                                                     workers=2, progress=lambda s: None)}
+        for closing in [t for t in threading.enumerate() if t.name == "close the local Dask cluster"]:
+            closing.join()   # it reads the configuration set here
     b, c = out["b.toml"], out["c.toml"]
     assert b["pid"] != c["pid"] and b["start"] < c["end"] and c["start"] < b["end"]
     assert min(b["start"], c["start"]) >= out["a.toml"]["end"] and out["d.toml"]["start"] >= c["end"]
