@@ -11,7 +11,7 @@ import pytest
 
 from odpipe.preprocess.flags import Flag, summary
 from odpipe.operations.report import decimals, html_table, significant
-from odpipe.products.residuals import edit_summary, report_tables, statistics
+from odpipe.products.residuals import edit_summary, report_tables, series, statistics
 
 
 @pytest.fixture
@@ -63,6 +63,9 @@ def test_one_stations_s_and_x_band_one_way_are_kept_apart(res):
     assert table["band"].tolist() == ["S", "X"]
     (_, table, _), = report_tables(statistics(res.assign(band="")))
     assert "band" not in table   # no band column where no row has one
+    used = ((res["flags"] == 0) & (res["status"] == "")).to_numpy()
+    assert series(res, ~used)[:2].tolist() == ["DSS-24 X", "DSS-24 S"]   # the plot's legend too
+    assert series(res.assign(band="X"), ~used)[:2].tolist() == ["DSS-24", "DSS-24"]
 
 
 def test_report_tables_show_mm_per_s_and_the_observed_unit(res):

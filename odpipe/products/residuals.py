@@ -200,7 +200,7 @@ def plot(res: pd.DataFrame, path, which: str = "postfit", title: str = "") -> No
         edited = (sub["flags"] != 0).to_numpy()
         y_all = sub[COLUMN[which]].to_numpy(float) * scale
         t_all = date2num(sub["epoch"].to_numpy("datetime64[ns]"))  # days: no unit conversion at each draw
-        stations = sub["station_rx"].astype(str).to_numpy()
+        stations = series(sub, edited)
         for station in sorted(set(stations[~edited])):
             sel = ~edited & (stations == station)
             y = y_all[sel]
@@ -226,6 +226,16 @@ def plot(res: pd.DataFrame, path, which: str = "postfit", title: str = "") -> No
 
 
 TICK_STEPS_H = (1, 2, 3, 6, 12, 24, 48, 96, 168)  # h: whole UTC hours and days
+
+
+def series(rows: pd.DataFrame, edited: np.ndarray) -> np.ndarray:
+    """The plot series of each row of one panel: its station, with its downlink band when the panel's used
+    rows hold more than one (a station's S- and X-band one-way drawn and summed apart)."""
+    stations = rows["station_rx"].astype(str).to_numpy()
+    bands = rows["band"].astype(str).to_numpy() if "band" in rows else np.full(len(rows), "")
+    if len(set(bands[~edited])) < 2:
+        return stations
+    return np.array([f"{s} {b}".rstrip() for s, b in zip(stations, bands)])
 
 
 def _tick_step_days(span_days: float, most: int = 9) -> float:
