@@ -20,8 +20,8 @@ y (k+1, n), F (k, 7, n), n_eval). The right-hand side is ``derivative(t, y,
 model, dy)``, which each dynamics module implements with
 ``numba.extending.overload`` selected by the type of its ``model`` (the
 orbit model tuple, the CRTBP parameter array); a dispatcher passed as an
-argument would defeat numba's on-disk cache. ``dense(t, y, F, tq)`` evaluates the
-interpolant at times ``tq``.
+argument would defeat numba's on-disk cache. ``dense(t, y, F, tq, n)`` evaluates the
+first ``n`` components of the interpolant at times ``tq``.
 """
 
 from __future__ import annotations
@@ -181,9 +181,9 @@ def integrate(model, t0, y0, t1, rtol, atol, h_max, n_err, h_first):
 
 
 @njit(cache=True)
-def dense(ts, ys, Fs, tq):
-    """Interpolated states (len(tq), n) at times ``tq`` inside [ts[0], ts[-1]]."""
-    n = ys.shape[1]
+def dense(ts, ys, Fs, tq, n):
+    """The first ``n`` interpolated components (len(tq), n) at times ``tq`` inside [ts[0], ts[-1]]
+    (``n = 6``: the state alone, without the variational columns)."""
     out = np.empty((tq.shape[0], n))
     nstep = ts.shape[0] - 1
     forward = ts[-1] >= ts[0]
@@ -195,7 +195,7 @@ def dense(ts, ys, Fs, tq):
             j = nstep - np.searchsorted(ts[::-1], t)
         j = min(max(j, 0), nstep - 1)
         if nstep == 0:
-            out[q] = ys[0]
+            out[q] = ys[0, :n]
             continue
         x = (t - ts[j]) / (ts[j + 1] - ts[j])
         for i in range(n):

@@ -52,25 +52,28 @@ class Trajectory:
     def segments(self) -> list[tuple[float, float]]:
         return [(float(p[0][0]), float(p[0][-1])) for p in self._pieces]
 
-    def _values(self, t) -> np.ndarray:
+    def _values(self, t, n: int | None = None) -> np.ndarray:
+        """The first ``n`` components (all by default) of the interpolated solution at ``t``, (N, n)."""
         t = np.atleast_1d(np.asarray(t, dtype=float))
         lo, hi = min(self.t0, self.t1), max(self.t0, self.t1)
         if np.any((t < lo) | (t > hi)):
             raise ValueError(f"epoch outside the trajectory arc [{lo}, {hi}] TDB s")
+        n = self._pieces[0][1].shape[1] if n is None else n
         if len(self._pieces) == 1:   # one integration segment (no restart inside the arc): no lookup
             ts, ys, Fs = self._pieces[0]
-            return dense(ts, ys, Fs, np.ascontiguousarray(t.ravel())) if len(ts) > 1 else np.repeat(ys[:1], t.size, axis=0)
-        n = self._pieces[0][1].shape[1]
+            return dense(ts, ys, Fs, np.ascontiguousarray(t.ravel()), n) if len(ts) > 1 else \
+                np.repeat(ys[:1, :n], t.size, axis=0)
         out = np.empty((t.size, n))
         idx = np.clip(np.searchsorted(self._starts, t, side="right") - 1, 0, len(self._pieces) - 1)
         for k in np.unique(idx):
             sel = idx == k
             ts, ys, Fs = self._pieces[self._order[k]]
-            out[sel] = dense(ts, ys, Fs, t[sel]) if len(ts) > 1 else ys[:1]
+            out[sel] = dense(ts, ys, Fs, t[sel], n) if len(ts) > 1 else ys[:1, :n]
         return out
 
     def state(self, t) -> np.ndarray:
-        return self._values(t)[:, :6]
+        """Position (m) and velocity (m/s), (N, 6): the state's six components alone are interpolated."""
+        return self._values(t, 6)
 
     def stm(self, t) -> np.ndarray:
         if not self.with_stm:

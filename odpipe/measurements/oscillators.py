@@ -32,11 +32,15 @@ def name(spacecraft: str, band: str | None = None, pass_id: int | None = None) -
 def row_names(spacecraft: str, rows: pd.DataFrame, known) -> np.ndarray:
     """Per row (columns ``band_down``, optional ``pass_id``), the most specific name of ``known`` that applies,
     else the spacecraft's own name (object array)."""
-    passes = rows["pass_id"] if "pass_id" in rows.columns else pd.Series(-1, index=rows.index)
-    combos = pd.MultiIndex.from_arrays([rows["band_down"].astype(str), passes.astype(int)])
-    which, unique = pd.factorize(combos)
-    names = []
-    for band, pid in unique:
-        specific = [n for n in (name(spacecraft, band, pid), name(spacecraft, band)) if n in known]
-        names.append(specific[0] if specific else name(spacecraft))
-    return np.array(names, dtype=object)[which]
+    bands = rows["band_down"].astype(str).to_numpy(object)
+    passes = rows["pass_id"].to_numpy().astype(int) if "pass_id" in rows.columns else np.full(len(rows), -1)
+    chosen: dict = {}   # (band, pass) -> name: a handful of combinations per call
+    out = np.empty(len(rows), dtype=object)
+    for i, combo in enumerate(zip(bands, passes.tolist())):
+        got = chosen.get(combo)
+        if got is None:
+            band, pid = combo
+            specific = [n for n in (name(spacecraft, band, pid), name(spacecraft, band)) if n in known]
+            got = chosen[combo] = specific[0] if specific else name(spacecraft)
+        out[i] = got
+    return out

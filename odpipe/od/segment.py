@@ -110,8 +110,14 @@ class SegmentTrajectory:
         return x, Phi, S
 
     def state(self, t) -> np.ndarray:
-        """Position (m) and velocity (m/s), (N, 6); post-maneuver at ``a``."""
-        return self._full(t)[0]
+        """Position (m) and velocity (m/s), (N, 6); post-maneuver at ``a``. Interpolates the state alone
+        (light-time solutions ask for states far more often than for partials)."""
+        t, before = self._pieces(t)
+        x = np.empty((t.size, 6))
+        for sel, traj in ((before, self._back), (~before, self._fwd)):
+            if sel.any():
+                x[sel] = traj.state(t[sel])
+        return x
 
     def stm(self, t) -> np.ndarray:
         """d x(t) / d x(a-), (N, 6, 6)."""
@@ -169,3 +175,7 @@ class ShiftedSegmentTrajectory(SegmentTrajectory):
     def _full(self, t) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         x, Phi, S = self.base._full(t)
         return x + Phi @ self._dx + S @ self._dp, Phi, S
+
+    def state(self, t) -> np.ndarray:
+        """Position (m) and velocity (m/s), (N, 6): the base's, shifted (needs its STM and sensitivities)."""
+        return self._full(t)[0]
