@@ -140,7 +140,8 @@ class _Unsupported(Exception):
 class Prepared:
     """Rows grouped once for :func:`compute`, for callers that evaluate the same rows again with other
     trajectories (a fit's segment at every iteration): the rows (index reset), their groups (key values,
-    positions, rows) and the TDB span (s) of their epochs (None without rows)."""
+    positions, rows, and a dict in which the group keeps what does not depend on the trajectories:
+    :attr:`Group.memo`) and the TDB span (s) of their epochs (None without rows)."""
 
     rows: pd.DataFrame
     groups: list
@@ -157,7 +158,7 @@ def prepare(rows: pd.DataFrame) -> Prepared:
     keys = [df["observable"], df["unit"], df["station_tx"], df["station_rx"], df["spacecraft"].astype(str),
             sc2.astype(str), df["tag"]]
     t, _ = anchor_from_utc(np.array([df["epoch"].min(), df["epoch"].max()], dtype="datetime64[ns]"))
-    return Prepared(df, [(key, idx, df.iloc[idx]) for key, idx in _groups(keys)], (float(t[0]), float(t[1])))
+    return Prepared(df, [(key, idx, df.iloc[idx], {}) for key, idx in _groups(keys)], (float(t[0]), float(t[1])))
 
 
 def compute(rows: pd.DataFrame, trajectories: Mapping, setup: MeasurementSetup,
@@ -170,9 +171,9 @@ def compute(rows: pd.DataFrame, trajectories: Mapping, setup: MeasurementSetup,
     if prep.span is not None:
         setup = spanning(setup, prep.span[0] - SPAN_MARGIN_S, prep.span[1] + SPAN_MARGIN_S)
     setup = _remembering(setup)
-    for key, idx, g in prep.groups:
+    for key, idx, g, memo in prep.groups:
         try:
-            comp, roles = _evaluate(key, g, trajectories, setup)
+            comp, roles = _evaluate(key, g, trajectories, setup, memo)
         except _Unsupported as exc:
             out.status[idx] = str(exc)
             continue
@@ -257,7 +258,9 @@ def spanning(setup: MeasurementSetup, t0: float, t1: float) -> MeasurementSetup:
 @dataclass
 class Group:
     """Rows sharing one observable, unit, link (tx, rx), spacecraft (sc, sc2) and time tag, with what a model
-    needs: the trajectories by spacecraft id and the set-up."""
+    needs: the trajectories by spacecraft id and the set-up. ``memo``: what the group's rows alone decide (their
+    epochs, count intervals and anchor epochs), kept by :class:`Prepared` across evaluations; its arrays are
+    read-only."""
 
     obs: str
     unit: str
@@ -269,17 +272,28 @@ class Group:
     rows: pd.DataFrame
     trajectories: Mapping
     setup: MeasurementSetup
+    memo: dict = field(default_factory=dict)
+
+    def _kept(self, key, make):
+        """``make()``, made once per group (its arrays read-only)."""
+        if key not in self.memo:
+            got = make()
+            for a in got if isinstance(got, tuple) else (got,):
+                a.setflags(write=False)
+            self.memo[key] = got
+        return self.memo[key]
 
     @property
     def epoch(self) -> np.ndarray:
-        return self.rows["epoch"].to_numpy(dtype="datetime64[ns]")
+        return self._kept("epoch", lambda: self.rows["epoch"].to_numpy(dtype="datetime64[ns]", copy=True))
 
     def trajectory(self, sc: str):
         return _trajectory(self.trajectories, sc)
 
     def solve(self, nodes, utc, anchor: str = "receive"):
         """The light-time solution of the path through ``nodes`` anchored at UTC ``utc``."""
-        t, c = anchor_from_utc(utc)
+        utc = np.asarray(utc, dtype="datetime64[ns]")
+        t, c = self._kept(("anchor", utc.tobytes()), lambda: anchor_from_utc(utc))
         return solve_path(nodes, t, anchor=anchor, t_corr=c, shapiro_bodies=self.setup.shapiro_bodies,
                           ephemeris=self.setup.ephemeris, origin=self.setup.origin)
 
@@ -287,15 +301,17 @@ class Group:
         """Count-interval starts and ends (UTC) and the light-time solutions there, each distinct epoch solved
         once (consecutive counts share their bounds)."""
         s, e = self.interval()
-        epochs, which = np.unique(np.concatenate([s, e]), return_inverse=True)
+        epochs, which = self._kept("interval_epochs", lambda: np.unique(np.concatenate([s, e]), return_inverse=True))
         sol = self.solve(nodes, epochs, anchor)
         return s, e, sol.take(which[:s.size]), sol.take(which[s.size:])
 
     def interval(self):
         """Start and end (UTC) of each row's count interval."""
-        s, e = interval_bounds(self.epoch.astype(np.int64), self.rows["count_time"].to_numpy(float),
-                               self.rows["tag"].to_numpy(object))
-        return s.astype("datetime64[ns]"), e.astype("datetime64[ns]")
+        def bounds():
+            s, e = interval_bounds(self.epoch.astype(np.int64), self.rows["count_time"].to_numpy(float),
+                                   self.rows["tag"].to_numpy(object))
+            return s.astype("datetime64[ns]"), e.astype("datetime64[ns]")
+        return self._kept("interval", bounds)
 
 
 MODELS: dict[str, Callable[[Group], tuple]] = {}  # observable -> model(group) -> (Computed, roles): the registry
@@ -311,11 +327,11 @@ def model(*observables: str):
     return register
 
 
-def _evaluate(key, g, trajectories, setup):
+def _evaluate(key, g, trajectories, setup, memo):
     obs, unit, tx, rx, sc, sc2, tag = key
     if obs not in MODELS:
         raise _Unsupported(f"observable {obs!r} has no model")
-    return MODELS[obs](Group(obs, unit, tx or rx, rx, sc, sc2, tag, g, trajectories, setup))
+    return MODELS[obs](Group(obs, unit, tx or rx, rx, sc, sc2, tag, g, trajectories, setup, memo))
 
 
 def _receiver(grp: Group, st_rx, traj) -> dict:
