@@ -157,7 +157,7 @@ def test_chained_arcs_run_after_their_source_and_not_after_a_failure(tmp_path, s
 
 
 def test_batch_killed_midway_resumes_without_redoing_arcs(tmp_path, scheduler):
-    configs = _arcs(tmp_path, 5, 2.0)
+    configs = _arcs(tmp_path, 5, 1.0)   # 1 s per arc: the poll below (0.2 s) sees two done well before a third
     script = ("import sys; from pathlib import Path; from odpipe.operations.nightly import run_batch;"
               "from tests.batch_job import run_arc;"
               "run_batch([Path(p) for p in sys.argv[1:]], run_arc, workers=1)")
