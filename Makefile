@@ -21,9 +21,11 @@ demo: $(STAMP)
 # in tests/conftest.py's order (files with slow tests first); xdist's default would reorder them by
 # their number of tests and start the long few-test files last. One BLAS thread per process, as odpipe/__init__.py
 # sets for the commands: pytest has imported numpy before any test imports odpipe, so there it comes too late.
+# Bytecode is cached even where the environment sets PYTHONDONTWRITEBYTECODE: without the cache every worker
+# rewrites the asserts of every test file and compiles odpipe, and every process a test starts compiles odpipe again.
 WORKERS ?= 2
 test: $(STAMP)
-	OPENBLAS_NUM_THREADS=1 OMP_NUM_THREADS=1 $(BIN)/python -m pytest -q -n $(WORKERS) --dist loadfile --no-loadscope-reorder
+	PYTHONDONTWRITEBYTECODE= OPENBLAS_NUM_THREADS=1 OMP_NUM_THREADS=1 $(BIN)/python -m pytest -q -n $(WORKERS) --dist loadfile --no-loadscope-reorder
 
 bench: $(STAMP)
 	for f in benchmarks/bench_*.py; do echo "== $$f"; $(BIN)/python $$f || exit 1; done

@@ -17,6 +17,7 @@ Tolerances and why:
 
 from __future__ import annotations
 
+import functools
 import re
 from pathlib import Path
 
@@ -123,12 +124,19 @@ def test_twin_recorded_figures_against_the_thesis():
 
 
 @pytest.mark.slow
-def test_twin_14_days_snapshot(twin_dir, twin_truth):
-    from odpipe.pipeline.demo import run_demo
+def test_twin_14_days_snapshot(twin_dir, twin_truth, monkeypatch):
+    from distributed import LocalCluster
 
-    # fits twin_truth's files; one Dask worker: the arcs are independent, so their figures do not depend on the
-    # number of workers, and a second worker process would only add its start-up beside make test's own workers
-    run_demo(twin_dir, 1, progress=lambda *_: None, days=14.0, case=load(TWIN))
+    from odpipe.operations.nightly import run_batch
+    from odpipe.pipeline import demo
+
+    # fits twin_truth's files on a Dask worker thread of this process: the arcs are independent, so their figures
+    # depend neither on the number of workers nor on where they run, and a worker process would pay the imports
+    # and kernel loads this process has done already, beside make test's own workers (the worker processes of
+    # run_batch's own cluster: tests/test_batch_faults.py, test_nightly_cluster.py)
+    with LocalCluster(n_workers=1, threads_per_worker=1, processes=False, dashboard_address=":0") as cluster:
+        monkeypatch.setattr(demo, "run_batch", functools.partial(run_batch, scheduler=cluster.scheduler_address))
+        demo.run_demo(twin_dir, 1, progress=lambda *_: None, days=14.0, case=load(TWIN))
     got = pd.read_csv(twin_dir / "thesis_comparison.csv")
     want = pd.read_csv(FIXTURES / "twin_14d_figures.csv")
     for figure in want["figure"]:

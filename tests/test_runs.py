@@ -110,22 +110,15 @@ def _arcs(tmp_path, n, seconds, fail=()):
 
 @pytest.fixture(scope="module")
 def scheduler():
-    """Address of a local Dask cluster of two single-threaded worker processes, started once for this module's
-    in-process batches (each run_batch of its own would start and stop one: seconds of CPU and wall each). The
-    cluster that run_batch starts itself is exercised by the killed batch's subprocess below."""
+    """Address of a local Dask cluster of two single-threaded workers in this process, started once for this module's
+    in-process batches (each run_batch of its own would start and stop a cluster of worker processes: seconds of
+    CPU and wall each; threads run the same tasks, outcomes and run directories without those processes' start-up).
+    The cluster of worker processes that run_batch starts itself is exercised by the killed batch's subprocess
+    below, tests/test_batch_faults.py and tests/test_nightly_cluster.py."""
     from distributed import LocalCluster
 
-    old = os.environ.get("PYTHONPATH")
-    os.environ["PYTHONPATH"] = str(ROOT)          # the workers import tests.batch_job
-    try:
-        cluster = LocalCluster(n_workers=2, threads_per_worker=1, processes=True, dashboard_address=":0")
-    finally:
-        if old is None:
-            del os.environ["PYTHONPATH"]
-        else:
-            os.environ["PYTHONPATH"] = old
-    yield cluster.scheduler_address
-    cluster.close()
+    with LocalCluster(n_workers=2, threads_per_worker=1, processes=False, dashboard_address=":0") as cluster:
+        yield cluster.scheduler_address
 
 
 @pytest.mark.slow
@@ -157,7 +150,7 @@ def test_chained_arcs_run_after_their_source_and_not_after_a_failure(tmp_path, s
 
 
 def test_batch_killed_midway_resumes_without_redoing_arcs(tmp_path, scheduler):
-    configs = _arcs(tmp_path, 5, 2.0)
+    configs = _arcs(tmp_path, 5, 1.0)   # 1 s per arc: the poll below (0.2 s) sees two done well before a third
     script = ("import sys; from pathlib import Path; from odpipe.operations.nightly import run_batch;"
               "from tests.batch_job import run_arc;"
               "run_batch([Path(p) for p in sys.argv[1:]], run_arc, workers=1)")
