@@ -3,6 +3,10 @@ PY ?= python3
 VENV := .venv
 BIN := $(VENV)/bin
 STAMP := $(VENV)/.installed
+# Bytecode is cached even where the environment sets PYTHONDONTWRITEBYTECODE (install, demo and tests alike):
+# without it every process (each pytest worker, each Dask worker, each command a test starts) compiles odpipe
+# again, and every pytest worker rewrites the asserts of every test file.
+export PYTHONDONTWRITEBYTECODE :=
 
 .PHONY: demo test bench clean
 
@@ -21,11 +25,9 @@ demo: $(STAMP)
 # in tests/conftest.py's order (files with slow tests first); xdist's default would reorder them by
 # their number of tests and start the long few-test files last. One BLAS thread per process, as odpipe/__init__.py
 # sets for the commands: pytest has imported numpy before any test imports odpipe, so there it comes too late.
-# Bytecode is cached even where the environment sets PYTHONDONTWRITEBYTECODE: without the cache every worker
-# rewrites the asserts of every test file and compiles odpipe, and every process a test starts compiles odpipe again.
 WORKERS ?= 2
 test: $(STAMP)
-	PYTHONDONTWRITEBYTECODE= OPENBLAS_NUM_THREADS=1 OMP_NUM_THREADS=1 $(BIN)/python -m pytest -q -n $(WORKERS) --dist loadfile --no-loadscope-reorder
+	OPENBLAS_NUM_THREADS=1 OMP_NUM_THREADS=1 $(BIN)/python -m pytest -q -n $(WORKERS) --dist loadfile --no-loadscope-reorder
 
 bench: $(STAMP)
 	for f in benchmarks/bench_*.py; do echo "== $$f"; $(BIN)/python $$f || exit 1; done
