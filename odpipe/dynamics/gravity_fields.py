@@ -77,20 +77,23 @@ def _field_table(field: GravityField, degree: int, grad_degree: int):
     return table
 
 
-_ROTATIONS: dict = {}  # (frame, lo, hi, segment, degree) -> fitted rotation channel: each reference segment of
-_ROTATIONS_KEPT = 512  # an arc is integrated again at every fit pass over the same span
+_ROTATIONS: dict = {}  # (frame, first piece, last piece, segment, degree) -> fitted rotation channel: every
+_ROTATIONS_KEPT = 512  # span inside the same whole pieces (each fit pass, each filter step) shares one fit
 
 
 def _rotation_channel(s: SphericalHarmonics, lo: float, hi: float):
-    """The Chebyshev table of ``s``'s ICRF-to-body-fixed rotation over [lo, hi], fitted once per span and
-    frame (a given ``rotation`` function: by identity; else the body's default frame)."""
+    """The Chebyshev table of ``s``'s ICRF-to-body-fixed rotation covering [lo, hi] (TDB s), in pieces on a
+    fixed grid (whole multiples of the piece length from J2000), so a rotation does not depend on how a
+    trajectory is cut into segments; fitted once per run of pieces and frame (a given ``rotation``
+    function: by identity; else the body's default frame)."""
     body = s.body.lower()
     seg, deg = ROTATION_GRID.get(body, (3600.0, 12))
-    key = (body if s.rotation is None else s.rotation, lo, hi, seg, deg)
+    first, last = int(np.floor(lo / seg)), int(np.ceil(hi / seg))
+    key = (body if s.rotation is None else s.rotation, first, max(last, first + 1), seg, deg)
     hit = _ROTATIONS.get(key)
     if hit is None:
         rot = s.rotation or default_rotation(body)
-        hit = fit_channel(lambda t: np.asarray(rot(t)).reshape(-1, 9), lo, hi, seg, deg)
+        hit = fit_channel(lambda t: np.asarray(rot(t)).reshape(-1, 9), key[1] * seg, key[2] * seg, seg, deg)
         while len(_ROTATIONS) >= _ROTATIONS_KEPT:
             _ROTATIONS.pop(next(iter(_ROTATIONS)))
         _ROTATIONS[key] = hit
