@@ -6,7 +6,6 @@ overlap sequence to those arcs (e.g. leaving out a start-up arc that spans the s
 from pathlib import Path
 
 from odpipe.errors import Exit, describe
-from odpipe.pipeline.config import RunSection, load_config
 from odpipe.operations.nightly import load_batch, night_summary, run_batch
 from odpipe.operations.schema import load, read_toml
 
@@ -25,6 +24,8 @@ def add_arguments(p):
 
 def arc_configs(arcs: list[Path]) -> tuple[dict, dict]:
     """(arc -> RunConfig of the arcs whose configuration loads, arc -> one line saying why the others do not)."""
+    from odpipe.pipeline.config import load_config  # the pipeline's imports: not for `odpipe batch --help`
+
     cfgs, broken = {}, {}
     for a in arcs:
         try:
@@ -36,6 +37,8 @@ def arc_configs(arcs: list[Path]) -> tuple[dict, dict]:
 
 def _root(arc: Path) -> Path | None:
     """The run folder of an arc whose configuration does not load, if its [run] table says it."""
+    from odpipe.pipeline.config import RunSection
+
     try:
         data, _ = read_toml(arc)
         run = load(RunSection, data.get("run"), Path(arc).resolve(), "run")
@@ -47,7 +50,9 @@ def _root(arc: Path) -> Path | None:
 def starts_from(arcs: list[Path], cfgs: dict | None = None, broken=()) -> dict:
     """arc -> the arcs of the batch whose products its a priori state is read from (``cfgs``: the loaded
     configurations, default: load them; ``broken``: arcs whose configuration does not load)."""
-    cfgs = {a: load_config(a) for a in arcs} if cfgs is None else cfgs
+    if cfgs is None:
+        from odpipe.pipeline.config import load_config
+        cfgs = {a: load_config(a) for a in arcs}
     roots = {a: (c.run.output / c.run.name).resolve() for a, c in cfgs.items()}
     roots.update({a: root for a in broken if (root := _root(a)) is not None})
     after = {}
@@ -65,6 +70,7 @@ def night_report(out: Path, arcs: list[Path], outcomes, overlap_arcs: list[Path]
     import pandas as pd
 
     from odpipe.analysis.overlap import consecutive_overlaps, oem_trajectory, report_tables
+    from odpipe.pipeline.config import load_config
     from odpipe.pipeline.setup import tdb
     from odpipe.products import residuals
     from parsers.atomic import write_csv
@@ -113,6 +119,17 @@ def night_report(out: Path, arcs: list[Path], outcomes, overlap_arcs: list[Path]
     return write_report(out / "report.html", title, headline, sections)
 
 
+def prepare_report() -> None:
+    """The imports of :func:`night_report` and of its plots (about 1 CPU-s), done while the arcs run."""
+    import matplotlib.backends.backend_agg  # noqa: F401
+    import matplotlib.figure  # noqa: F401
+
+    import odpipe.analysis.overlap  # noqa: F401
+    import odpipe.operations.report  # noqa: F401
+    import odpipe.pipeline.setup  # noqa: F401
+    import odpipe.products.residuals  # noqa: F401
+
+
 def _arc(path: Path) -> dict:
     from odpipe.pipeline.run import run_config
     return run_config(path, progress=None)
@@ -133,7 +150,7 @@ def run(args) -> int:
     from odpipe.pipeline.warmup import warm_worker
     outcomes = run_batch(arcs, _arc_forced if args.force else _arc, after=starts_from(arcs, cfgs, broken),
                          scheduler=args.scheduler, workers=args.workers or batch.workers, failed=broken,
-                         warm=warm_worker)
+                         warm=warm_worker, meanwhile=prepare_report if batch.report is not None else None)
     print(night_summary(outcomes))
     if batch.report is not None:
         print(f"report: {night_report(batch.report, arcs, outcomes, overlap_arcs, args.config)}")

@@ -15,6 +15,7 @@ The batch configuration (``[batch]`` table) is :class:`BatchSection`.
 from __future__ import annotations
 
 import logging
+import os
 import threading
 import time
 from dataclasses import dataclass, field
@@ -22,6 +23,7 @@ from pathlib import Path
 from typing import Callable
 
 from odpipe.errors import describe
+from odpipe.operations.quick_exit import skip_final_collection
 from odpipe.operations.schema import checked, load_file, positive
 
 _log = logging.getLogger(__name__)
@@ -61,6 +63,7 @@ class ArcOutcome:
 
 
 def _guarded(run_one: Callable[[Path], dict], config: str, *after: ArcOutcome) -> ArcOutcome:
+    skip_final_collection()   # in the worker: it exits in a fraction of a second once the cluster closes
     failed = [Path(o.config).name for o in after if o.status == "failed"]
     if failed:
         return ArcOutcome(config, "failed", 0.0, error=f"not run: it starts from {', '.join(failed)}, which failed")
@@ -115,15 +118,35 @@ def _local_cluster(workers: int):
 
 
 def _warmed(warm: Callable[[list], None], configs: list) -> None:
+    skip_final_collection()
     try:
         warm([Path(c) for c in configs])
     except Exception as exc:  # a worker that could not be warmed still runs its arcs (then paying the start-up)
         _log.warning("warming a worker failed: %s", describe(exc)[1])
 
 
+def _in_background(work: Callable[[], None]) -> threading.Thread:
+    """A thread running ``work`` at the lowest CPU priority (Linux: a thread's own nice value), so the arcs'
+    processes keep the cores; its failure is logged, never fatal (the caller does the same work later)."""
+    def run():
+        try:
+            os.setpriority(os.PRIO_PROCESS, threading.get_native_id(), 19)
+        except (AttributeError, OSError):   # not Linux: the thread runs at the process's priority
+            pass
+        try:
+            work()
+        except Exception as exc:
+            _log.warning("preparing what follows the arcs failed: %s", describe(exc)[1])
+
+    thread = threading.Thread(target=run, name="prepare what follows the arcs", daemon=True)
+    thread.start()
+    return thread
+
+
 def run_batch(configs, run_one: Callable[[Path], dict], *, after: dict | None = None, scheduler: str | None = None,
               workers: int = 2, progress: Callable[[str], None] = _log.info,
-              failed: dict | None = None, warm: Callable[[list], None] | None = None) -> list[ArcOutcome]:
+              failed: dict | None = None, warm: Callable[[list], None] | None = None,
+              meanwhile: Callable[[], None] | None = None) -> list[ArcOutcome]:
     """Run every arc config; returns one outcome per arc in completion order.
 
     ``after``: config -> configs whose products it starts from (run first: an arc is sent to the cluster once
@@ -134,7 +157,9 @@ def run_batch(configs, run_one: Callable[[Path], dict], *, after: dict | None = 
     why it cannot run (e.g. its configuration does not load): reported failed first, with the
     arcs that start from it. ``warm(configs)``: run once in every worker at a lower priority than
     the arcs, so a worker that waits for a chain's first arc pays its imports and loads then
-    (:func:`odpipe.pipeline.warmup.warm_worker`); its failure is logged, never fatal.
+    (:func:`odpipe.pipeline.warmup.warm_worker`); its failure is logged, never fatal. ``meanwhile()``: run in
+    this process once the first arcs are sent, in a background thread at the lowest CPU priority (e.g. the
+    imports of the night's report, which would otherwise follow the last arc); its failure is logged.
     """
     from distributed import Client, as_completed
 
@@ -164,6 +189,7 @@ def run_batch(configs, run_one: Callable[[Path], dict], *, after: dict | None = 
                                           key=f"arc-{configs.index(c)}", priority=rank[c], pure=False))
 
         submit_ready()
+        preparing = None if meanwhile is None else _in_background(meanwhile)
         if warm is not None:   # after the arcs: a worker given the first arc runs this only when idle
             for k, address in enumerate(client.scheduler_info()["workers"]):
                 client.submit(_warmed, warm, configs, key=f"warm-{k}", workers=[address],
@@ -175,6 +201,8 @@ def run_batch(configs, run_one: Callable[[Path], dict], *, after: dict | None = 
             note = f": {out.error}" if out.error else ""
             progress(f"[{len(outcomes)}/{total}] {Path(out.config).name}: {out.status} in {out.seconds:.1f} s{note}")
             submit_ready()
+    if preparing is not None:
+        preparing.join()
     if cluster is not None:   # the caller's summary and report need no worker
         threading.Thread(target=cluster.close, name="close the local Dask cluster").start()
     return outcomes

@@ -1,0 +1,135 @@
+"""Process start-up and the nightly's fixed costs: wall and CPU seconds of fresh processes (figures printed,
+never asserted).
+
+    python benchmarks/bench_startup.py [--repeat 5] [--nightly N] [--batch runs/grail_b_nightly.toml]
+
+Fresh processes (each ``--repeat`` times, the median and the range): ``odpipe --help``, ``odpipe batch --help``,
+the import of what a batch's client needs to load its arcs (``odpipe.commands.batch``), the import of a run
+(``odpipe.pipeline.run``), what a batch worker pays before its first arc (:func:`odpipe.pipeline.warmup.warm_worker`
+on the nightly's arcs: the run's imports, the gravity fields, numba's cached kernels of each force model).
+CPU seconds are the child's own (user + system), so they mean the same on a loaded machine.
+
+``--nightly N`` also runs the batch (``odpipe batch CONFIG --force``, its products in the config's folders) N
+times and splits each run's wall time into: before the first arc starts (command start to the earliest arc
+attempt's ``started``), the arcs (to the latest arc's ``finished``), the night's report (to the printed
+``report:`` line) and the exit after it (the process's end). Run it on two checkouts in turn (interleaved)
+on a shared machine, and state the load (printed).
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import os
+import resource
+import statistics
+import subprocess
+import sys
+import threading
+import time
+from datetime import datetime
+from pathlib import Path
+
+ROOT = Path(__file__).resolve().parents[1]
+BIN = Path(sys.executable).parent
+NIGHTLY = ROOT / "runs" / "grail_b_nightly.toml"
+
+
+def _children_cpu() -> float:
+    r = resource.getrusage(resource.RUSAGE_CHILDREN)
+    return r.ru_utime + r.ru_stime
+
+
+def timed(cmd: list[str], cwd: Path = ROOT) -> dict:
+    """Wall and CPU s of one process (its own and its children's, once reaped) and every line
+    it writes to stdout or stderr with its arrival time (s after the start)."""
+    cpu0, t0 = _children_cpu(), time.perf_counter()
+    p = subprocess.Popen(cmd, cwd=cwd, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+    lines: list[tuple[float, str]] = []
+
+    def read(stream):
+        for line in stream:
+            lines.append((time.perf_counter() - t0, line.rstrip("\n")))
+
+    readers = [threading.Thread(target=read, args=(s,)) for s in (p.stdout, p.stderr)]
+    for r in readers:
+        r.start()
+    for r in readers:
+        r.join()
+    rc = p.wait()
+    wall, cpu = time.perf_counter() - t0, _children_cpu() - cpu0
+    if rc != 0:
+        raise SystemExit(f"{' '.join(map(str, cmd))}: exit status {rc}\n" + "\n".join(s for _, s in lines[-20:]))
+    return {"wall": wall, "cpu": cpu, "lines": sorted(lines), "start_epoch": time.time() - wall}
+
+
+def fresh_processes(batch: Path, repeat: int) -> None:
+    """Wall and CPU seconds of each fresh process, median and range over ``repeat``."""
+    python, odpipe = str(BIN / "python"), str(BIN / "odpipe")
+    arcs = [str(p) for p in _arcs(batch)]
+    cases = {
+        "odpipe --help": [odpipe, "--help"],
+        "odpipe batch --help": [odpipe, "batch", "--help"],
+        "import odpipe.commands.batch (client)": [python, "-c", "import odpipe.commands.batch"],
+        "import odpipe.pipeline.run": [python, "-c", "import odpipe.pipeline.run"],
+        "import + warm_worker(nightly arcs)": [python, "-c", "import sys; from odpipe.pipeline.warmup import warm_worker;"
+                                               " warm_worker(sys.argv[1:])", *arcs],
+    }
+    print(f"fresh processes, {repeat} each (load {os.getloadavg()[0]:.1f}); median [min, max]")
+    for name, cmd in cases.items():
+        runs = [timed(cmd) for _ in range(repeat)]
+        w, c = [r["wall"] for r in runs], [r["cpu"] for r in runs]
+        print(f"  {name:42s} wall {statistics.median(w):5.2f} s [{min(w):.2f}, {max(w):.2f}]   "
+              f"CPU {statistics.median(c):5.2f} s [{min(c):.2f}, {max(c):.2f}]")
+
+
+def _arcs(batch: Path) -> list[Path]:
+    from odpipe.operations.nightly import load_batch
+    return sorted(set(load_batch(batch).arcs))
+
+
+def _attempt(arc: Path, after: float) -> dict:
+    """The manifest of ``arc``'s newest attempt started after the epoch ``after`` (s)."""
+    from odpipe.pipeline.config import load_config
+    cfg = load_config(arc)
+    folders = sorted((cfg.run.output / cfg.run.name / "attempts").glob("*"))
+    for folder in reversed(folders):
+        manifest = folder / "manifest.json"
+        if manifest.is_file():
+            m = json.loads(manifest.read_text())
+            if datetime.fromisoformat(m["started"]).timestamp() >= after:
+                return m
+    raise SystemExit(f"{arc}: no complete attempt of this run")
+
+
+def nightly(batch: Path) -> None:
+    """One ``odpipe batch --force`` run of ``batch``, its wall time split at the first arc's start, the last arc's
+    end and the printed report line."""
+    load = os.getloadavg()[0]
+    r = timed([str(BIN / "odpipe"), "batch", batch.name, "--force"], cwd=batch.parent)
+    t0 = r["start_epoch"]
+    manifests = [_attempt(a, t0) for a in _arcs(batch)]
+    first = min(datetime.fromisoformat(m["started"]).timestamp() for m in manifests) - t0
+    last = max(datetime.fromisoformat(m["finished"]).timestamp() for m in manifests) - t0
+    report = next((t for t, line in r["lines"] if line.startswith("report:")), float("nan"))
+    print(f"  nightly: wall {r['wall']:5.1f} s, CPU {r['cpu']:5.1f} s (load {load:.1f} before): before the first arc "
+          f"{first:4.2f} s, arcs {last - first:5.2f} s, report {report - last:4.2f} s, exit after the report "
+          f"{r['wall'] - report:4.2f} s")
+
+
+def main() -> None:
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("--repeat", type=int, default=5, help="fresh processes of each kind")
+    ap.add_argument("--nightly", type=int, default=0, help="runs of the batch (default none)")
+    ap.add_argument("--batch", type=Path, default=NIGHTLY, help="the batch configuration")
+    ap.add_argument("--no-fresh", action="store_true", help="only the batch runs")
+    args = ap.parse_args()
+    batch = args.batch.resolve()
+    if not args.no_fresh:
+        fresh_processes(batch, args.repeat)
+    for _ in range(args.nightly):
+        nightly(batch)
+
+
+if __name__ == "__main__":
+    main()
