@@ -6,8 +6,10 @@ overlap sequence to those arcs (e.g. leaving out a start-up arc that spans the s
 from pathlib import Path
 
 from odpipe.errors import Exit, describe
-from odpipe.operations.nightly import load_batch, night_summary, run_batch
+from odpipe.operations.nightly import load_batch, night_summary, run_batch, start_local_cluster
 from odpipe.operations.schema import load, read_toml
+
+RUN_IMPORTS = ("odpipe.pipeline.run",)   # what every worker imports before its first arc
 
 NAME = "batch"
 HELP = ("run many arcs (a nightly batch config listing arc configs) in parallel; skips arcs whose config, "
@@ -146,11 +148,15 @@ def run(args) -> int:
         raise ValueError(f"--workers {args.workers}: must be at least 1")
     arcs = sorted(set(batch.arcs))
     overlap_arcs = None if batch.overlaps is None else set(batch.overlaps)
+    workers = args.workers or batch.workers
+    # the workers start (and import the run) while this process loads the arcs' configurations
+    cluster = None if args.scheduler else start_local_cluster(workers, RUN_IMPORTS)
     cfgs, broken = arc_configs(arcs)
     from odpipe.pipeline.warmup import warm_worker
     outcomes = run_batch(arcs, _arc_forced if args.force else _arc, after=starts_from(arcs, cfgs, broken),
-                         scheduler=args.scheduler, workers=args.workers or batch.workers, failed=broken,
-                         warm=warm_worker, meanwhile=prepare_report if batch.report is not None else None)
+                         scheduler=args.scheduler, workers=workers, failed=broken, warm=warm_worker,
+                         meanwhile=prepare_report if batch.report is not None else None, cluster=cluster,
+                         imports=RUN_IMPORTS)
     print(night_summary(outcomes))
     if batch.report is not None:
         print(f"report: {night_report(batch.report, arcs, outcomes, overlap_arcs, args.config)}")

@@ -18,12 +18,12 @@ import logging
 import os
 import threading
 import time
+from concurrent.futures import Future, ThreadPoolExecutor
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Callable
 
 from odpipe.errors import describe
-from odpipe.operations.quick_exit import skip_final_collection
 from odpipe.operations.schema import checked, load_file, positive
 
 _log = logging.getLogger(__name__)
@@ -63,7 +63,6 @@ class ArcOutcome:
 
 
 def _guarded(run_one: Callable[[Path], dict], config: str, *after: ArcOutcome) -> ArcOutcome:
-    skip_final_collection()   # in the worker: it exits in a fraction of a second once the cluster closes
     failed = [Path(o.config).name for o in after if o.status == "failed"]
     if failed:
         return ArcOutcome(config, "failed", 0.0, error=f"not run: it starts from {', '.join(failed)}, which failed")
@@ -105,20 +104,50 @@ def chain_lengths(configs: list[str], sources: dict) -> dict[str, int]:
     return length
 
 
-def _local_cluster(workers: int):
+def _local_cluster(workers: int, imports: tuple[str, ...] = ()):
     """``workers`` single-threaded worker processes on any free port (never clashing with a running cluster),
     with glibc's own heap trimming: Dask's default ``MALLOC_TRIM_THRESHOLD_`` of 64 kB also fixes glibc's mmap
     threshold, so every array above 128 kB is mapped and unmapped again (a GRAIL arc: 5x the page faults,
-    3x the system time and 26 % more CPU in all than the same arc in a plain process)."""
+    3x the system time and 26 % more CPU in all than the same arc in a plain process). The workers are forked
+    from one server process (multiprocessing's forkserver, started here) that has imported Dask and ``imports``
+    (module names, e.g. the run's 2 CPU-s of imports): each worker starts with them, paid once for all."""
     import dask
     from distributed import LocalCluster
 
-    with dask.config.set({"distributed.nanny.pre-spawn-environ.MALLOC_TRIM_THRESHOLD_": None}):
+    _forkserver(imports)
+    with dask.config.set(_CLUSTER):
         return LocalCluster(n_workers=workers, threads_per_worker=1, processes=True, dashboard_address=":0")
 
 
+_CLUSTER = {"distributed.nanny.pre-spawn-environ.MALLOC_TRIM_THRESHOLD_": None,
+            "distributed.worker.multiprocessing-method": "forkserver"}
+
+
+def _forkserver(imports: tuple[str, ...]) -> None:
+    """Start the server the workers are forked from; its imports begin at once (a server already running keeps
+    its own)."""
+    import dask
+    from multiprocessing import forkserver
+
+    from distributed.utils import get_mp_context
+
+    with dask.config.set(_CLUSTER):
+        get_mp_context().set_forkserver_preload(["distributed", *imports])   # after Dask's own list
+        forkserver.ensure_running()
+
+
+def start_local_cluster(workers: int, imports: tuple[str, ...] = ()) -> Future:
+    """:func:`_local_cluster` started in a background thread (the future's result: the cluster), so the caller
+    goes on (e.g. loading its configurations) while the workers' processes import ``imports``."""
+    _forkserver(tuple(imports))   # here: in the thread it would share the interpreter with the caller's work
+    pool = ThreadPoolExecutor(1, thread_name_prefix="start the local Dask cluster")
+    try:
+        return pool.submit(_local_cluster, workers, tuple(imports))
+    finally:
+        pool.shutdown(wait=False)
+
+
 def _warmed(warm: Callable[[list], None], configs: list) -> None:
-    skip_final_collection()
     try:
         warm([Path(c) for c in configs])
     except Exception as exc:  # a worker that could not be warmed still runs its arcs (then paying the start-up)
@@ -146,7 +175,8 @@ def _in_background(work: Callable[[], None]) -> threading.Thread:
 def run_batch(configs, run_one: Callable[[Path], dict], *, after: dict | None = None, scheduler: str | None = None,
               workers: int = 2, progress: Callable[[str], None] = _log.info,
               failed: dict | None = None, warm: Callable[[list], None] | None = None,
-              meanwhile: Callable[[], None] | None = None) -> list[ArcOutcome]:
+              meanwhile: Callable[[], None] | None = None, cluster: Future | None = None,
+              imports: tuple[str, ...] = ()) -> list[ArcOutcome]:
     """Run every arc config; returns one outcome per arc in completion order.
 
     ``after``: config -> configs whose products it starts from (run first: an arc is sent to the cluster once
@@ -160,6 +190,8 @@ def run_batch(configs, run_one: Callable[[Path], dict], *, after: dict | None = 
     (:func:`odpipe.pipeline.warmup.warm_worker`); its failure is logged, never fatal. ``meanwhile()``: run in
     this process once the first arcs are sent, in a background thread at the lowest CPU priority (e.g. the
     imports of the night's report, which would otherwise follow the last arc); its failure is logged.
+    ``cluster``: the local cluster already starting (:func:`start_local_cluster`), else one is started here,
+    its workers importing ``imports`` (module names) before their first arc.
     """
     from distributed import Client, as_completed
 
@@ -171,9 +203,13 @@ def run_batch(configs, run_one: Callable[[Path], dict], *, after: dict | None = 
         outcomes.append(out)
         progress(f"[{len(outcomes)}/{total}] {Path(out.config).name}: failed: {out.error}")
     configs = [c for c in dependency_order([str(c) for c in configs], after) if c not in broken]
+    starting, cluster = cluster, None
     if not configs:
+        if starting is not None:
+            _close_in_background(starting.result())
         return outcomes
-    cluster = None if scheduler else _local_cluster(workers)
+    if not scheduler:
+        cluster = starting.result() if starting is not None else _local_cluster(workers, imports)
     inside = set(configs)
     sources = {c: [d for d in after.get(c, ()) if d in broken or d in inside] for c in configs}
     rank = chain_lengths(configs, sources)
@@ -204,8 +240,13 @@ def run_batch(configs, run_one: Callable[[Path], dict], *, after: dict | None = 
     if preparing is not None:
         preparing.join()
     if cluster is not None:   # the caller's summary and report need no worker
-        threading.Thread(target=cluster.close, name="close the local Dask cluster").start()
+        _close_in_background(cluster)
     return outcomes
+
+
+def _close_in_background(cluster) -> None:
+    """Close a local cluster while the caller goes on (its workers take a fraction of a second to exit)."""
+    threading.Thread(target=cluster.close, name="close the local Dask cluster").start()
 
 
 def night_summary(outcomes: list[ArcOutcome]) -> str:
