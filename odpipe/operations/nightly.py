@@ -124,22 +124,38 @@ _CLUSTER = {"distributed.nanny.pre-spawn-environ.MALLOC_TRIM_THRESHOLD_": None,
 
 
 def _forkserver(imports: tuple[str, ...]) -> None:
-    """Start the server the workers are forked from; its imports begin at once (a server already running keeps
-    its own)."""
-    import dask
+    """Start the server the workers are forked from, in the environment Dask gives the workers it spawns (its
+    ``pre-spawn-environ`` without ``MALLOC_TRIM_THRESHOLD_``: one BLAS and OpenMP thread; ``PYTHONHASHSEED``
+    as Dask's nanny sets it), so the libraries it imports start as they would in a spawned worker. Its imports
+    begin at once, before this process has imported Distributed (a server already running keeps its own)."""
+    import multiprocessing
+    import os
     from multiprocessing import forkserver
 
-    from distributed.utils import get_mp_context
+    import dask
 
     with dask.config.set(_CLUSTER):
-        get_mp_context().set_forkserver_preload(["distributed", *imports])   # after Dask's own list
+        env = {k: os.environ.get(k, str(v)) for k, v in dask.config.get("distributed.nanny.pre-spawn-environ").items()
+               if v is not None}
+    if env.get("PYTHONHASHSEED") in (None, "0"):
+        env["PYTHONHASHSEED"] = "6640"   # Dask's nanny's choice for its workers
+    saved = {k: os.environ.get(k) for k in env}
+    multiprocessing.get_context("forkserver").set_forkserver_preload(["distributed", *imports])
+    os.environ.update(env)
+    try:
         forkserver.ensure_running()
+    finally:
+        for k, v in saved.items():
+            if v is None:
+                os.environ.pop(k, None)
+            else:
+                os.environ[k] = v
 
 
 def start_local_cluster(workers: int, imports: tuple[str, ...] = ()) -> Future:
     """:func:`_local_cluster` started in a background thread (the future's result: the cluster), so the caller
     goes on (e.g. loading its configurations) while the workers' processes import ``imports``."""
-    _forkserver(tuple(imports))   # here: in the thread it would share the interpreter with the caller's work
+    _forkserver(tuple(imports))
     pool = ThreadPoolExecutor(1, thread_name_prefix="start the local Dask cluster")
     try:
         return pool.submit(_local_cluster, workers, tuple(imports))
