@@ -93,10 +93,12 @@ def timed(cmd: list[str], cwd: Path = ROOT) -> dict:
     wall = time.perf_counter() - t0
     for r in readers:
         r.join()
-    cpu = max(_reaped_cpu() - cpu0, sum(seen.values()))
+    reaped, sampled = _reaped_cpu() - cpu0, sum(seen.values())
+    cpu = max(reaped, sampled)
     if rc != 0:
         raise SystemExit(f"{' '.join(map(str, cmd))}: exit status {rc}\n" + "\n".join(s for _, s in lines[-20:]))
-    return {"wall": wall, "cpu": cpu, "lines": sorted(lines), "start_epoch": time.time() - wall}
+    return {"wall": wall, "cpu": cpu, "reaped": reaped, "sampled": sampled, "lines": sorted(lines),
+            "start_epoch": time.time() - wall}
 
 
 def fresh_processes(batch: Path, repeat: int) -> None:
@@ -112,8 +114,8 @@ def fresh_processes(batch: Path, repeat: int) -> None:
                                                " warm_worker(sys.argv[1:])", *arcs],
     }
     print(f"fresh processes, {repeat} each (load {os.getloadavg()[0]:.1f}); median [min, max]")
-    for name, cmd in cases.items():
-        runs = [timed(cmd) for _ in range(repeat)]
+    for name, cmd in cases.items():   # from the batch's folder: no package there shadows the one to measure
+        runs = [timed(cmd, cwd=batch.parent) for _ in range(repeat)]
         w, c = [r["wall"] for r in runs], [r["cpu"] for r in runs]
         print(f"  {name:42s} wall {statistics.median(w):5.2f} s [{min(w):.2f}, {max(w):.2f}]   "
               f"CPU {statistics.median(c):5.2f} s [{min(c):.2f}, {max(c):.2f}]")
@@ -148,7 +150,8 @@ def nightly(batch: Path) -> None:
     first = min(datetime.fromisoformat(m["started"]).timestamp() for m in manifests) - t0
     last = max(datetime.fromisoformat(m["finished"]).timestamp() for m in manifests) - t0
     report = next((t for t, line in r["lines"] if line.startswith("report:")), float("nan"))
-    print(f"  nightly: wall {r['wall']:5.1f} s, CPU {r['cpu']:5.1f} s (load {load:.1f} before): before the first arc "
+    print(f"  nightly: wall {r['wall']:5.1f} s, CPU {r['cpu']:5.1f} s (reaped {r['reaped']:.1f}, sampled "
+          f"{r['sampled']:.1f}; load {load:.1f} before): before the first arc "
           f"{first:4.2f} s, arcs {last - first:5.2f} s, report {report - last:4.2f} s, exit after the report "
           f"{r['wall'] - report:4.2f} s")
 

@@ -129,7 +129,6 @@ def _forkserver(imports: tuple[str, ...]) -> None:
     as Dask's nanny sets it), so the libraries it imports start as they would in a spawned worker. Its imports
     begin at once, before this process has imported Distributed (a server already running keeps its own)."""
     import multiprocessing
-    import os
     from multiprocessing import forkserver
 
     import dask
