@@ -66,9 +66,10 @@ def starts_from(arcs: list[Path], cfgs: dict | None = None, broken=()) -> dict:
 
 
 def night_report(out: Path, arcs: list[Path], outcomes, overlap_arcs: list[Path] | None = None,
-                 config: Path | None = None) -> Path:
+                 config: Path | None = None, cfgs: dict | None = None) -> Path:
     """The batch's report in ``out``: residual statistics per arc and station, overlaps of consecutive
-    arcs among ``overlap_arcs`` (default all); titled by the batch configuration ``config`` (its name)."""
+    arcs among ``overlap_arcs`` (default all); titled by the batch configuration ``config`` (its name).
+    ``cfgs``: arc -> its configuration as the batch loaded it (default: load them again)."""
     import pandas as pd
 
     from odpipe.analysis.overlap import consecutive_overlaps, oem_trajectory, report_tables
@@ -84,7 +85,7 @@ def night_report(out: Path, arcs: list[Path], outcomes, overlap_arcs: list[Path]
     for a in arcs:
         if status[a.resolve()].status == "failed":
             continue
-        cfg = load_config(a)
+        cfg = cfgs[a] if cfgs is not None and a in cfgs else load_config(a)
         run = cfg.run.output / cfg.run.name / "current"
         if (run / "trajectory.oem").exists():
             done.append((tdb(cfg.arc.start), cfg.run.name, run, a))
@@ -159,5 +160,5 @@ def run(args) -> int:
                          imports=RUN_IMPORTS)
     print(night_summary(outcomes))
     if batch.report is not None:
-        print(f"report: {night_report(batch.report, arcs, outcomes, overlap_arcs, args.config)}")
+        print(f"report: {night_report(batch.report, arcs, outcomes, overlap_arcs, args.config, cfgs)}")
     return Exit.PARTIAL if any(o.status == "failed" for o in outcomes) else Exit.OK
