@@ -7,13 +7,16 @@ Fresh processes (each ``--repeat`` times, the median and the range): ``odpipe --
 the import of what a batch's client needs to load its arcs (``odpipe.commands.batch``), the import of a run
 (``odpipe.pipeline.run``), what a batch worker pays before its first arc (:func:`odpipe.pipeline.warmup.warm_worker`
 on the nightly's arcs: the run's imports, the gravity fields, numba's cached kernels of each force model).
-CPU seconds are the child's own (user + system), so they mean the same on a loaded machine.
+CPU seconds (user + system) are the process's and those of every process under it, so they mean the same on a
+loaded machine.
 
 ``--nightly N`` also runs the batch (``odpipe batch CONFIG --force``, its products in the config's folders) N
 times and splits each run's wall time into: before the first arc starts (command start to the earliest arc
-attempt's ``started``), the arcs (to the latest arc's ``finished``), the night's report (to the printed
-``report:`` line) and the exit after it (the process's end). Run it on two checkouts in turn (interleaved)
-on a shared machine, and state the load (printed).
+attempt's ``started``, stamped once the worker has loaded that arc's configuration and hashed its inputs), the
+arcs (to the latest arc's ``finished``), the night's report (to the printed ``report:`` line) and the exit after
+it (the process's end). Run it on two checkouts in turn (interleaved) on a shared machine, and state the load
+(printed); another checkout's code runs with this venv as
+``PYTHONPATH=OTHER python benchmarks/bench_startup.py --batch OTHER/runs/grail_b_nightly.toml``.
 """
 
 from __future__ import annotations
