@@ -22,6 +22,7 @@ from pathlib import Path
 import odpipe.commands
 from odpipe import log
 from odpipe.errors import MEANING, Exit, describe
+from odpipe.operations.quick_exit import skip_final_collection
 
 _log = logging.getLogger("odpipe")
 
@@ -82,6 +83,7 @@ def _command_in(argv: list[str]) -> str | None:
 def main(argv: list[str] | None = None) -> int:
     """Run ``odpipe`` with ``argv`` (default: the process's); returns the exit status."""
     argv = sys.argv[1:] if argv is None else list(argv)
+    skip_final_collection()
     parser = build_parser(_command_in(argv) or "")
     args = parser.parse_args(argv)
     log.configure(1 if args.debug else args.verbose - args.quiet)

@@ -6,9 +6,10 @@ overlap sequence to those arcs (e.g. leaving out a start-up arc that spans the s
 from pathlib import Path
 
 from odpipe.errors import Exit, describe
-from odpipe.pipeline.config import RunSection, load_config
-from odpipe.operations.nightly import load_batch, night_summary, run_batch
+from odpipe.operations.nightly import load_batch, night_summary, run_batch, start_local_cluster
 from odpipe.operations.schema import load, read_toml
+
+RUN_IMPORTS = ("odpipe.pipeline.run",)   # what every worker imports before its first arc
 
 NAME = "batch"
 HELP = ("run many arcs (a nightly batch config listing arc configs) in parallel; skips arcs whose config, "
@@ -25,6 +26,8 @@ def add_arguments(p):
 
 def arc_configs(arcs: list[Path]) -> tuple[dict, dict]:
     """(arc -> RunConfig of the arcs whose configuration loads, arc -> one line saying why the others do not)."""
+    from odpipe.pipeline.config import load_config  # the pipeline's imports: not for `odpipe batch --help`
+
     cfgs, broken = {}, {}
     for a in arcs:
         try:
@@ -36,6 +39,8 @@ def arc_configs(arcs: list[Path]) -> tuple[dict, dict]:
 
 def _root(arc: Path) -> Path | None:
     """The run folder of an arc whose configuration does not load, if its [run] table says it."""
+    from odpipe.pipeline.config import RunSection
+
     try:
         data, _ = read_toml(arc)
         run = load(RunSection, data.get("run"), Path(arc).resolve(), "run")
@@ -47,7 +52,9 @@ def _root(arc: Path) -> Path | None:
 def starts_from(arcs: list[Path], cfgs: dict | None = None, broken=()) -> dict:
     """arc -> the arcs of the batch whose products its a priori state is read from (``cfgs``: the loaded
     configurations, default: load them; ``broken``: arcs whose configuration does not load)."""
-    cfgs = {a: load_config(a) for a in arcs} if cfgs is None else cfgs
+    if cfgs is None:
+        from odpipe.pipeline.config import load_config
+        cfgs = {a: load_config(a) for a in arcs}
     roots = {a: (c.run.output / c.run.name).resolve() for a, c in cfgs.items()}
     roots.update({a: root for a in broken if (root := _root(a)) is not None})
     after = {}
@@ -59,12 +66,14 @@ def starts_from(arcs: list[Path], cfgs: dict | None = None, broken=()) -> dict:
 
 
 def night_report(out: Path, arcs: list[Path], outcomes, overlap_arcs: list[Path] | None = None,
-                 config: Path | None = None) -> Path:
+                 config: Path | None = None, cfgs: dict | None = None) -> Path:
     """The batch's report in ``out``: residual statistics per arc and station, overlaps of consecutive
-    arcs among ``overlap_arcs`` (default all); titled by the batch configuration ``config`` (its name)."""
+    arcs among ``overlap_arcs`` (default all); titled by the batch configuration ``config`` (its name).
+    ``cfgs``: arc -> its configuration as the batch loaded it (default: load them again)."""
     import pandas as pd
 
     from odpipe.analysis.overlap import consecutive_overlaps, oem_trajectory, report_tables
+    from odpipe.pipeline.config import load_config
     from odpipe.pipeline.setup import tdb
     from odpipe.products import residuals
     from parsers.atomic import write_csv
@@ -76,7 +85,7 @@ def night_report(out: Path, arcs: list[Path], outcomes, overlap_arcs: list[Path]
     for a in arcs:
         if status[a.resolve()].status == "failed":
             continue
-        cfg = load_config(a)
+        cfg = cfgs[a] if cfgs is not None and a in cfgs else load_config(a)
         run = cfg.run.output / cfg.run.name / "current"
         if (run / "trajectory.oem").exists():
             done.append((tdb(cfg.arc.start), cfg.run.name, run, a))
@@ -113,6 +122,17 @@ def night_report(out: Path, arcs: list[Path], outcomes, overlap_arcs: list[Path]
     return write_report(out / "report.html", title, headline, sections)
 
 
+def prepare_report() -> None:
+    """The imports of :func:`night_report` and of its plots (about 1 CPU-s), done while the arcs run."""
+    import matplotlib.backends.backend_agg  # noqa: F401
+    import matplotlib.figure  # noqa: F401
+
+    import odpipe.analysis.overlap  # noqa: F401
+    import odpipe.operations.report  # noqa: F401
+    import odpipe.pipeline.setup  # noqa: F401
+    import odpipe.products.residuals  # noqa: F401
+
+
 def _arc(path: Path) -> dict:
     from odpipe.pipeline.run import run_config
     return run_config(path, progress=None)
@@ -129,12 +149,16 @@ def run(args) -> int:
         raise ValueError(f"--workers {args.workers}: must be at least 1")
     arcs = sorted(set(batch.arcs))
     overlap_arcs = None if batch.overlaps is None else set(batch.overlaps)
+    workers = args.workers or batch.workers
+    # the workers start (and import the run) while this process loads the arcs' configurations
+    cluster = None if args.scheduler else start_local_cluster(workers, RUN_IMPORTS)
     cfgs, broken = arc_configs(arcs)
     from odpipe.pipeline.warmup import warm_worker
     outcomes = run_batch(arcs, _arc_forced if args.force else _arc, after=starts_from(arcs, cfgs, broken),
-                         scheduler=args.scheduler, workers=args.workers or batch.workers, failed=broken,
-                         warm=warm_worker)
+                         scheduler=args.scheduler, workers=workers, failed=broken, warm=warm_worker,
+                         meanwhile=prepare_report if batch.report is not None else None, cluster=cluster,
+                         imports=RUN_IMPORTS)
     print(night_summary(outcomes))
     if batch.report is not None:
-        print(f"report: {night_report(batch.report, arcs, outcomes, overlap_arcs, args.config)}")
+        print(f"report: {night_report(batch.report, arcs, outcomes, overlap_arcs, args.config, cfgs)}")
     return Exit.PARTIAL if any(o.status == "failed" for o in outcomes) else Exit.OK

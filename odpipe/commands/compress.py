@@ -4,11 +4,6 @@ from __future__ import annotations
 
 import logging
 
-from odpipe.commands._inputs import read_table
-from odpipe.pipeline.geometry import median_round_trip
-from odpipe.preprocess import store
-from odpipe.preprocess.compress import compress
-
 NAME = "compress"
 HELP = "compress Doppler to a longer count time (exact averages / phase differences)"
 log = logging.getLogger(__name__)
@@ -27,6 +22,11 @@ def add_arguments(parser) -> None:
 
 
 def run(args) -> int:
+    from odpipe.commands._inputs import read_table   # the pipeline's imports: not for `odpipe compress --help`
+    from odpipe.pipeline.geometry import median_round_trip
+    from odpipe.preprocess import store
+    from odpipe.preprocess.compress import compress
+
     table, ramps = read_table(args.input)
     delay = median_round_trip(table) if args.ramp_delay is None else args.ramp_delay
     if args.ramp_delay is None:

@@ -4,12 +4,6 @@ from __future__ import annotations
 
 from pathlib import Path
 
-from odpipe.commands._inputs import read_table
-from odpipe.preprocess import store
-from odpipe.products.tdm import to_tdm
-from parsers import formats
-from parsers.table import TrackingData
-
 NAME = "convert"
 HELP = "convert a tracking file to TrackingTable Parquet (.parquet) or CCSDS TDM (.tdm/.kvn KVN, .xml XML)"
 TDM_SYNTAX = {".tdm": "kvn", ".kvn": "kvn", ".xml": "xml"}
@@ -24,6 +18,10 @@ def add_arguments(parser) -> None:
 
 def load(path, errors: str = "raise") -> TrackingData:
     """TrackingData from a TrackingTable Parquet file or any file a reader recognises."""
+    from odpipe.commands._inputs import read_table   # the readers' imports: not for `odpipe convert --help`
+    from parsers import formats
+    from parsers.table import TrackingData
+
     if str(path).endswith(".parquet"):
         return TrackingData(*read_table(path))
     data = formats.read_any(path, errors=errors)
@@ -36,10 +34,13 @@ def run(args) -> int:
     suffix = Path(args.output).suffix.lower()
     if suffix != ".parquet" and suffix not in TDM_SYNTAX:
         raise ValueError(f"{args.output}: cannot write {suffix!r} files: name OUT.parquet, OUT.tdm, OUT.kvn or OUT.xml")
+    from odpipe.preprocess import store
+
     data = load(args.input, args.errors)  # a ParseError, or a file with no tracking data: the CLI's one line
     if suffix == ".parquet":
         written = store.write(args.output, data.table, data.ramps)
     else:
+        from odpipe.products.tdm import to_tdm
         from parsers import tdm
 
         if "segments" not in data.meta:  # not read from a TDM: map the table onto TDM keywords

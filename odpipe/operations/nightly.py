@@ -15,8 +15,10 @@ The batch configuration (``[batch]`` table) is :class:`BatchSection`.
 from __future__ import annotations
 
 import logging
+import os
 import threading
 import time
+from concurrent.futures import Future, ThreadPoolExecutor
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Callable
@@ -102,16 +104,62 @@ def chain_lengths(configs: list[str], sources: dict) -> dict[str, int]:
     return length
 
 
-def _local_cluster(workers: int):
+def _local_cluster(workers: int, imports: tuple[str, ...] = ()):
     """``workers`` single-threaded worker processes on any free port (never clashing with a running cluster),
     with glibc's own heap trimming: Dask's default ``MALLOC_TRIM_THRESHOLD_`` of 64 kB also fixes glibc's mmap
     threshold, so every array above 128 kB is mapped and unmapped again (a GRAIL arc: 5x the page faults,
-    3x the system time and 26 % more CPU in all than the same arc in a plain process)."""
+    3x the system time and 26 % more CPU in all than the same arc in a plain process). The workers are forked
+    from one server process (multiprocessing's forkserver, started here) that has imported Dask and ``imports``
+    (module names, e.g. the run's 2 CPU-s of imports): each worker starts with them, paid once for all."""
     import dask
     from distributed import LocalCluster
 
-    with dask.config.set({"distributed.nanny.pre-spawn-environ.MALLOC_TRIM_THRESHOLD_": None}):
+    _forkserver(imports)
+    with dask.config.set(_CLUSTER):
         return LocalCluster(n_workers=workers, threads_per_worker=1, processes=True, dashboard_address=":0")
+
+
+_CLUSTER = {"distributed.nanny.pre-spawn-environ.MALLOC_TRIM_THRESHOLD_": None,
+            "distributed.worker.multiprocessing-method": "forkserver"}
+
+
+def _forkserver(imports: tuple[str, ...]) -> None:
+    """Start the server the workers are forked from, in the environment Dask gives the workers it spawns (its
+    ``pre-spawn-environ`` without ``MALLOC_TRIM_THRESHOLD_``: one BLAS and OpenMP thread; ``PYTHONHASHSEED``
+    as Dask's nanny sets it), so the libraries it imports start as they would in a spawned worker. Its imports
+    begin at once, before this process has imported Distributed (a server already running keeps its own)."""
+    import multiprocessing
+    from multiprocessing import forkserver
+
+    import dask
+
+    with dask.config.set(_CLUSTER):
+        env = {k: os.environ.get(k, str(v)) for k, v in dask.config.get("distributed.nanny.pre-spawn-environ").items()
+               if v is not None}
+    if env.get("PYTHONHASHSEED") in (None, "0"):
+        env["PYTHONHASHSEED"] = "6640"   # Dask's nanny's choice for its workers
+    saved = {k: os.environ.get(k) for k in env}
+    multiprocessing.get_context("forkserver").set_forkserver_preload(["distributed", *imports])
+    os.environ.update(env)
+    try:
+        forkserver.ensure_running()
+    finally:
+        for k, v in saved.items():
+            if v is None:
+                os.environ.pop(k, None)
+            else:
+                os.environ[k] = v
+
+
+def start_local_cluster(workers: int, imports: tuple[str, ...] = ()) -> Future:
+    """:func:`_local_cluster` started in a background thread (the future's result: the cluster), so the caller
+    goes on (e.g. loading its configurations) while the workers' processes import ``imports``."""
+    _forkserver(tuple(imports))
+    pool = ThreadPoolExecutor(1, thread_name_prefix="start the local Dask cluster")
+    try:
+        return pool.submit(_local_cluster, workers, tuple(imports))
+    finally:
+        pool.shutdown(wait=False)
 
 
 def _warmed(warm: Callable[[list], None], configs: list) -> None:
@@ -121,9 +169,29 @@ def _warmed(warm: Callable[[list], None], configs: list) -> None:
         _log.warning("warming a worker failed: %s", describe(exc)[1])
 
 
+def _in_background(work: Callable[[], None]) -> threading.Thread:
+    """A thread running ``work`` at the lowest CPU priority (Linux: a thread's own nice value), so the arcs'
+    processes keep the cores; its failure is logged, never fatal (the caller does the same work later)."""
+    def run():
+        try:
+            os.setpriority(os.PRIO_PROCESS, threading.get_native_id(), 19)
+        except (AttributeError, OSError):   # not Linux: the thread runs at the process's priority
+            pass
+        try:
+            work()
+        except Exception as exc:
+            _log.warning("preparing what follows the arcs failed: %s", describe(exc)[1])
+
+    thread = threading.Thread(target=run, name="prepare what follows the arcs", daemon=True)
+    thread.start()
+    return thread
+
+
 def run_batch(configs, run_one: Callable[[Path], dict], *, after: dict | None = None, scheduler: str | None = None,
               workers: int = 2, progress: Callable[[str], None] = _log.info,
-              failed: dict | None = None, warm: Callable[[list], None] | None = None) -> list[ArcOutcome]:
+              failed: dict | None = None, warm: Callable[[list], None] | None = None,
+              meanwhile: Callable[[], None] | None = None, cluster: Future | None = None,
+              imports: tuple[str, ...] = ()) -> list[ArcOutcome]:
     """Run every arc config; returns one outcome per arc in completion order.
 
     ``after``: config -> configs whose products it starts from (run first: an arc is sent to the cluster once
@@ -134,7 +202,11 @@ def run_batch(configs, run_one: Callable[[Path], dict], *, after: dict | None = 
     why it cannot run (e.g. its configuration does not load): reported failed first, with the
     arcs that start from it. ``warm(configs)``: run once in every worker at a lower priority than
     the arcs, so a worker that waits for a chain's first arc pays its imports and loads then
-    (:func:`odpipe.pipeline.warmup.warm_worker`); its failure is logged, never fatal.
+    (:func:`odpipe.pipeline.warmup.warm_worker`); its failure is logged, never fatal. ``meanwhile()``: run in
+    this process once the first arcs are sent, in a background thread at the lowest CPU priority (e.g. the
+    imports of the night's report, which would otherwise follow the last arc); its failure is logged.
+    ``cluster``: the local cluster already starting (:func:`start_local_cluster`), else one is started here,
+    its workers importing ``imports`` (module names) before their first arc.
     """
     from distributed import Client, as_completed
 
@@ -146,9 +218,13 @@ def run_batch(configs, run_one: Callable[[Path], dict], *, after: dict | None = 
         outcomes.append(out)
         progress(f"[{len(outcomes)}/{total}] {Path(out.config).name}: failed: {out.error}")
     configs = [c for c in dependency_order([str(c) for c in configs], after) if c not in broken]
+    starting, cluster = cluster, None
     if not configs:
+        if starting is not None:
+            _close_in_background(starting.result())
         return outcomes
-    cluster = None if scheduler else _local_cluster(workers)
+    if not scheduler:
+        cluster = starting.result() if starting is not None else _local_cluster(workers, imports)
     inside = set(configs)
     sources = {c: [d for d in after.get(c, ()) if d in broken or d in inside] for c in configs}
     rank = chain_lengths(configs, sources)
@@ -164,6 +240,7 @@ def run_batch(configs, run_one: Callable[[Path], dict], *, after: dict | None = 
                                           key=f"arc-{configs.index(c)}", priority=rank[c], pure=False))
 
         submit_ready()
+        preparing = None if meanwhile is None else _in_background(meanwhile)
         if warm is not None:   # after the arcs: a worker given the first arc runs this only when idle
             for k, address in enumerate(client.scheduler_info()["workers"]):
                 client.submit(_warmed, warm, configs, key=f"warm-{k}", workers=[address],
@@ -175,9 +252,16 @@ def run_batch(configs, run_one: Callable[[Path], dict], *, after: dict | None = 
             note = f": {out.error}" if out.error else ""
             progress(f"[{len(outcomes)}/{total}] {Path(out.config).name}: {out.status} in {out.seconds:.1f} s{note}")
             submit_ready()
+    if preparing is not None:
+        preparing.join()
     if cluster is not None:   # the caller's summary and report need no worker
-        threading.Thread(target=cluster.close, name="close the local Dask cluster").start()
+        _close_in_background(cluster)
     return outcomes
+
+
+def _close_in_background(cluster) -> None:
+    """Close a local cluster while the caller goes on (its workers take a fraction of a second to exit)."""
+    threading.Thread(target=cluster.close, name="close the local Dask cluster").start()
 
 
 def night_summary(outcomes: list[ArcOutcome]) -> str:

@@ -180,7 +180,7 @@ def run_demo(out: Path = Path("out/demo"), workers: int = 2, progress=print, day
                 write_text(path, text)
             configs.append(path)
         progress(f"fitting {len(configs)} arcs on {workers} workers ...")
-        outcomes = run_batch(configs, _run_arc, workers=workers, progress=progress)
+        outcomes = run_batch(configs, _run_arc, workers=workers, progress=progress, imports=("odpipe.pipeline.demo",))
     progress(night_summary(outcomes))
     progress(compile_note(main_compile, outcomes))
     return _report(out, case, plan, files, truth)

@@ -20,9 +20,6 @@ from pathlib import Path
 
 import numpy as np
 
-from odpipe.dynamics.forces import ForceModel
-from odpipe.dynamics.propagator import propagate
-
 DAYS = 11.0  # two station-keeping maneuvers (days 3.5 and 10.5) and an attitude burn: short and long arcs
 GM_EARTH = 3.986004415e14  # m^3/s^2
 
@@ -33,6 +30,8 @@ def other_kernels() -> None:
     ``gtd7`` on writable arrays (drag and direct calls differ in array mutability) and the a priori
     orbit search's grid kernels (``od.apriori.circular_search``, about 6 s to compile)."""
     from odpipe.dynamics.crtbp import crtbp_rhs
+    from odpipe.dynamics.forces import ForceModel
+    from odpipe.dynamics.propagator import propagate
     from odpipe.environment.atmosphere.nrlmsise00 import gtd7
     from odpipe.od.apriori import circular_search
 
@@ -59,6 +58,7 @@ def warm_worker(configs: list) -> None:
     import matplotlib.pyplot  # noqa: F401  (the products' residual plots)
 
     from odpipe.dynamics.forces import BODY_RADIUS, EmpiricalRTN
+    from odpipe.dynamics.propagator import propagate
     from odpipe.pipeline import run  # noqa: F401  (every stage's imports)
     from odpipe.pipeline.config import load_config
     from odpipe.pipeline.setup import force_model, tdb
