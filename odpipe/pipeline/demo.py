@@ -86,8 +86,10 @@ def data_sigmas(case) -> dict:
     return sig
 
 
-def arc_config(case, files: dict, name: str, a: float, b: float, x0: np.ndarray, sigmas: dict) -> str:
-    """Run configuration (TOML text) of arc ``name`` over [a, b] (TDB s) of the simulated case in ``files``."""
+def arc_config(case, files: dict, name: str, a: float, b: float, x0: np.ndarray, sigmas: dict,
+               plots: bool = True) -> str:
+    """Run configuration (TOML text) of arc ``name`` over [a, b] (TDB s) of the simulated case in ``files``
+    (``plots``: the arc's residual plots)."""
     fitted = {f"utdf:{n.station}" for n in fitted_networks(case)}
     data = [Path(p).name for k, p in files.items() if k == "trk234" or k in fitted]
     body = case.body
@@ -129,7 +131,7 @@ edit_against_reference = true   # arcs across burns: the plume after one must no
 [products]
 naif_id = {case.naif_id}
 step = 600.0
-"""
+""" + ("" if plots else "plots = false\n")
 
 
 def _run_arc(path: Path) -> dict:
@@ -149,9 +151,10 @@ def compile_note(main, outcomes) -> str:
 
 
 def run_demo(out: Path = Path("out/demo"), workers: int = 2, progress=print, days: float | None = None,
-             case=None) -> dict:
+             case=None, plots: bool = True) -> dict:
     """Run the whole demo into ``out`` (``days``: only the case's first days; ``case``: a loaded case instead
-    of ``runs/artemis_p2_like.toml``); returns the headline figures."""
+    of ``runs/artemis_p2_like.toml``; ``plots=False``: no per-arc residual plots, the figures unchanged);
+    returns the headline figures."""
     out = Path(out).resolve()
     case = load_case(CASE) if case is None else case
     case = case if days is None else case.shortened(days)
@@ -175,7 +178,7 @@ def run_demo(out: Path = Path("out/demo"), workers: int = 2, progress=print, day
         configs = []
         for name, _, a, b in plan:
             path = arc_dir / f"{name}.toml"
-            text = arc_config(case, files, name, a, b, truth.state(a)[0] + OFFSET, sigmas)
+            text = arc_config(case, files, name, a, b, truth.state(a)[0] + OFFSET, sigmas, plots)
             if not path.exists() or path.read_text() != text:
                 write_text(path, text)
             configs.append(path)
