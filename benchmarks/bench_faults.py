@@ -11,7 +11,8 @@ night starts from the same inputs: every arc and the night's report are complete
 each arc has exactly one complete attempt (no arc fitted twice), every other attempt folder is marked
 abandoned, and no temporary file is left.
 
-Run: ``.venv/bin/python benchmarks/bench_faults.py [--kills 20] [--arcs 6] [--min-delay 5] [--max-delay 100] [--seed 1]``.
+Run: ``.venv/bin/python benchmarks/bench_faults.py [--kills 20] [--arcs 6] [--min-delay 5] [--max-delay 100] [--seed 1]
+[--from-fit]`` (``--from-fit``: the delay counts from the first arc's start instead of the batch's).
 """
 
 from __future__ import annotations
@@ -79,6 +80,18 @@ def _pgid(pid: int) -> int | None:
         return None if fields[0] == b"Z" else int(fields[2])
     except (OSError, IndexError, ValueError):
         return None
+
+
+def attempts(out: Path) -> set:
+    """Every attempt folder of every arc so far."""
+    return set(out.glob("*/attempts/*"))
+
+
+def wait_for_fitting(out: Path, proc: subprocess.Popen, timeout: float = 300.0) -> None:
+    """Return once the batch ``proc`` has started an arc (a new attempt folder under ``out``) or has ended."""
+    before, deadline = attempts(out), time.time() + timeout
+    while proc.poll() is None and not attempts(out) - before and time.time() < deadline:
+        time.sleep(0.05)
 
 
 def finished(out: Path) -> dict:
@@ -162,12 +175,14 @@ def check_night(folder: Path, arcs: int) -> dict:
 
 
 def fault_loop(folder: Path, kills: int, arcs: int = 6, min_delay: float = 5.0, max_delay: float = 100.0,
-               seed: int = 1, say=print) -> dict:
+               seed: int = 1, say=print, from_fit: bool = False) -> dict:
     """Run the batch and SIGKILL it after a random delay until ``kills`` kills have hit a running batch.
 
-    A run that ends before its kill is a finished night: it is checked (:func:`check_night`) and its
-    outputs removed, and the next run starts a new night from the same inputs; after the last kill the
-    batch runs to the end and that night is checked too."""
+    The delay counts from the batch's start, or (``from_fit``) from its first arc starting, so that a kill
+    lands among the fits whatever the machine's load makes of the start-up. A run that ends before its kill
+    is a finished night: it is checked (:func:`check_night`) and its outputs removed, and the next run starts
+    a new night from the same inputs; after the last kill the batch runs to the end and that night is checked
+    too."""
     rng = np.random.default_rng(seed)
     batch = write_night(folder, arcs)
     out, night = folder / "out", folder / "night"
@@ -191,6 +206,9 @@ def fault_loop(folder: Path, kills: int, arcs: int = 6, min_delay: float = 5.0, 
             before = finished(out)
             delay = float(rng.uniform(min_delay, max_delay))
             proc, t0 = start_batch(batch, log), time.perf_counter()
+            if from_fit:
+                wait_for_fitting(out, proc)
+            fitting = time.perf_counter() - t0
             try:
                 rc = proc.wait(timeout=delay)
                 assert rc == 0, f"a batch run failed (rc {rc}); see {folder / 'batch.log'}"
@@ -202,9 +220,12 @@ def fault_loop(folder: Path, kills: int, arcs: int = 6, min_delay: float = 5.0, 
             lost = {a: f for a, f in before.items() if after.get(a) != f}
             assert not lost, f"kill {len(rows) + 1}: finished arcs lost or redone: {lost}"
             rows.append({"kill": len(rows) + 1, "night": len(nights) + 1, "delay_s": round(delay, 1),
+                         "first_arc_s": round(fitting, 1) if from_fit else None,
                          "processes_killed": n_proc, "arcs_done_before": len(before), "arcs_done_after": len(after)})
-            say(f"kill {len(rows)}/{kills} (night {len(nights) + 1}) after {delay:.1f} s: {n_proc} processes "
-                f"killed, {len(after)}/{arcs} arcs done ({len(after) - len(before)} in this run)")
+            say(f"kill {len(rows)}/{kills} (night {len(nights) + 1}) after {delay:.1f} s"
+                + (f" from the first arc's start ({fitting:.1f} s after the batch's)" if from_fit else "")
+                + f": {n_proc} processes killed, {len(after)}/{arcs} arcs done "
+                f"({len(after) - len(before)} in this run)")
         proc, t0 = start_batch(batch, log), time.perf_counter()
         rc = proc.wait()
     assert rc == 0, f"the last batch run failed (rc {rc}); see {folder / 'batch.log'}"
@@ -224,16 +245,19 @@ def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--kills", type=int, default=20)
     ap.add_argument("--arcs", type=int, default=6)
-    ap.add_argument("--min-delay", type=float, default=5.0, help="s after the batch's start, at the earliest")
-    ap.add_argument("--max-delay", type=float, default=100.0, help="s after the batch's start, at the latest")
+    ap.add_argument("--min-delay", type=float, default=5.0,
+                    help="s after the batch's start (--from-fit: its first arc's), at the earliest")
+    ap.add_argument("--max-delay", type=float, default=100.0,
+                    help="s after the batch's start (--from-fit: its first arc's), at the latest")
     ap.add_argument("--seed", type=int, default=1)
+    ap.add_argument("--from-fit", action="store_true", help="count the delay from the first arc's start")
     ap.add_argument("--keep", type=Path, help="work in this folder (kept) instead of a temporary one")
     args = ap.parse_args()
     if args.keep:
-        fault_loop(args.keep, args.kills, args.arcs, args.min_delay, args.max_delay, args.seed)
+        fault_loop(args.keep, args.kills, args.arcs, args.min_delay, args.max_delay, args.seed, from_fit=args.from_fit)
         return
     with tempfile.TemporaryDirectory() as tmp:
-        fault_loop(Path(tmp), args.kills, args.arcs, args.min_delay, args.max_delay, args.seed)
+        fault_loop(Path(tmp), args.kills, args.arcs, args.min_delay, args.max_delay, args.seed, from_fit=args.from_fit)
 
 
 if __name__ == "__main__":

@@ -150,7 +150,7 @@ def test_chained_arcs_run_after_their_source_and_not_after_a_failure(tmp_path, s
 
 
 def test_batch_killed_midway_resumes_without_redoing_arcs(tmp_path, scheduler):
-    configs = _arcs(tmp_path, 5, 1.0)   # 1 s per arc: the poll below (0.2 s) sees two done well before a third
+    configs = _arcs(tmp_path, 5, 0.5)   # 0.5 s per arc: the poll below (0.1 s) sees two done well before a third
     script = ("import sys; from pathlib import Path; from odpipe.operations.nightly import run_batch;"
               "from tests.batch_job import run_arc;"
               "run_batch([Path(p) for p in sys.argv[1:]], run_arc, workers=1)")
@@ -160,7 +160,7 @@ def test_batch_killed_midway_resumes_without_redoing_arcs(tmp_path, scheduler):
     out = tmp_path / "out"
     deadline = time.time() + 120
     while time.time() < deadline and len(list(out.glob("*/current"))) < 2:
-        time.sleep(0.2)
+        time.sleep(0.1)
     os.killpg(proc.pid, signal.SIGKILL)
     proc.wait()
     done = {p.parent.name: json.loads((p / "manifest.json").read_text())["finished"] for p in out.glob("*/current")}
