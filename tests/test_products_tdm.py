@@ -71,3 +71,15 @@ def test_tdm_from_odf_read_by_ccsds_ndm(messenger, tmp_path):
     assert first.epoch.startswith("2007-06-04T20:53:12")
     assert 880 / 749 * 7177641534.0 - first.receive_freq_1 == pytest.approx(1.563486099, abs=2e-6)
     assert dss14.metadata.turnaround_numerator == 880 and dss14.metadata.turnaround_denominator == 749
+
+
+@pytest.mark.realdata
+def test_convert_counts_observations_and_ramp_lines(messenger, shared_data, tmp_path, capsys):
+    """`odpipe convert ODF -o X.tdm` counts the ODF's observations and, apart, the TRANSMIT_FREQ and
+    TRANSMIT_FREQ_RATE line each of its 169 ramp records becomes."""
+    from odpipe.cli import main
+
+    assert main(["convert", str(shared_data / "messenger" / "odf07155.odf"), "-o", str(tmp_path / "m.tdm")]) == 0
+    n, ramps = len(messenger.table), len(messenger.ramps)
+    assert ramps == 169
+    assert f"{n + 2 * ramps} rows ({n} observations, {2 * ramps} ramp lines) -> " in capsys.readouterr().out

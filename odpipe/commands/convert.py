@@ -49,5 +49,14 @@ def run(args) -> int:
                 print(f"not written (no TDM keyword, or no value): {skipped['observable'].value_counts().to_dict()}")
         tdm.write(args.output, data, syntax=TDM_SYNTAX[suffix])
         written = [args.output]
-    print(f"{len(data.table)} rows -> {', '.join(map(str, written))}; {len(data.report)} records reported unreadable")
+    print(f"{_counts(data.table)} -> {', '.join(map(str, written))}; {len(data.report)} records reported unreadable")
     return 0
+
+
+def _counts(table) -> str:
+    """'N rows', or for TDM data lines 'N rows (M observations, K ramp lines)': a TDM holds the uplink's ramps
+    as TRANSMIT_FREQ/TRANSMIT_FREQ_RATE lines beside the observations."""
+    if "keyword" not in table.columns:
+        return f"{len(table)} rows"
+    ramp = int(table["keyword"].astype(str).str.startswith("TRANSMIT_FREQ").sum())
+    return f"{len(table)} rows ({len(table) - ramp} observations, {ramp} ramp lines)"
