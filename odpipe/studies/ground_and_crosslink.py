@@ -217,7 +217,8 @@ def _problem(cfg, setup, rows: pd.DataFrame, reg, fm: dict, t0: float, t1: float
 
 
 def fit_case(cfg, setup, rows: pd.DataFrame, guess: dict, fm: dict, t0: float, t1: float, shared=None):
-    """Fit one schedule's rows; returns the odpipe Solution and the registry."""
+    """Fit one schedule's rows (``shared``: segments already flown, e.g. :func:`apriori_segments`); returns the
+    odpipe Solution and the registry."""
     reg = registry(cfg, guess)
     opts = FitOptions(max_iter=cfg["filter"]["max_iter"], block=cfg["filter"]["block_s"])
     prob = _problem(cfg, setup, rows, reg, fm, t0, t1, shared)
