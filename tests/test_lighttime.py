@@ -7,7 +7,7 @@ import pytest
 import spiceypy as sp
 
 from odpipe.constants import C_LIGHT
-from odpipe.measurements.lighttime import solve_path
+from odpipe.measurements.lighttime import _first_guess, solve_path
 from odpipe.measurements.nodes import SpacecraftNode, StationNode, geocentric_tdb_minus_tt
 from test_measurements_helpers import DE440, DSS14_ITRS, GM, CircularTrajectory, Perturbed, rigid_earth
 
@@ -165,3 +165,39 @@ def test_geocentric_tdb_minus_tt_matches_erfa_and_its_amplitude():
     ref = erfa.dtdb(2451545.0, t / 86400.0, 0.0, 0.0, 0.0, 0.0)
     np.testing.assert_allclose(geocentric_tdb_minus_tt(t), ref, atol=1e-12)
     assert 1.6e-3 < np.max(np.abs(ref)) < 1.7e-3  # the annual term, 1.657 ms
+
+
+class _Straight:
+    """A node in uniform straight motion (m, m/s), counting its evaluations."""
+
+    def __init__(self, r, v):
+        self.r, self.v, self.calls = np.asarray(r, float), np.asarray(v, float), 0
+
+    def state(self, t):
+        self.calls += 1
+        t = np.atleast_1d(t)[:, None]
+        return np.hstack([self.r + self.v * t, np.broadcast_to(self.v, (t.shape[0], 3))])
+
+    def tdb_minus_clock(self, t, state):
+        return np.zeros(np.size(t))
+
+
+def test_first_leg_guess_is_the_exact_light_time_of_uniform_motion():
+    """A transmitter in uniform motion at 30 km/s (a cislunar spacecraft seen from the SSB), 4e8 m from the receiver:
+    c tau = |d + v tau| has the closed form (c^2 - v^2) tau^2 - 2 d.v tau - d^2 = 0. The first leg's guess (the Newton
+    step from zero with the path's curvature) is within 1e-12 s of it in every direction of v, where the distance
+    alone is off by up to 4e-5 s; so the leg needs one evaluation at the guess, no more (counted)."""
+    rng = np.random.default_rng(1)
+    v = rng.normal(size=(50, 3))
+    v *= 3e4 / np.linalg.norm(v, axis=1)[:, None]
+    d = np.array([4e8, 1e7, -2e7])
+    dv = v @ d
+    exact = (dv + np.sqrt(dv**2 + (C_LIGHT**2 - np.sum(v**2, 1)) * (d @ d))) / (C_LIGHT**2 - np.sum(v**2, 1))
+    s_free = np.hstack([np.zeros((50, 3)), v])                     # the transmitter at the reception epoch
+    none = np.zeros((0, 50, 3))
+    guess = _first_guess(np.tile(d, (50, 1)), s_free, none, none, np.zeros(0), -1.0)
+    assert np.max(np.abs(guess - exact)) < 1e-12
+    assert np.max(np.abs(np.linalg.norm(d) / C_LIGHT - exact)) > 3e-5
+    tx, rx = _Straight(np.zeros(3), v[0]), _Straight(d, np.zeros(3))
+    sol = solve_path([tx, rx], np.zeros(1), shapiro_bodies=())
+    assert sol.light_time[0] == pytest.approx(exact[0], abs=1e-15) and tx.calls == 2     # guess state, one Newton

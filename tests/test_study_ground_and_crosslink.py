@@ -24,6 +24,7 @@ from scipy.stats import chi2
 from odpipe.dynamics.propagator import propagate
 from odpipe.environment.ephemeris import Ephemeris
 from odpipe.environment.stations import itrs_to_geodetic
+from odpipe.estimation.fit import _sweep, build_grid
 from odpipe.frames.earth import gcrs_to_itrs_state
 from odpipe.studies import ground_and_crosslink as ground
 from odpipe.studies import schedule_trade
@@ -175,6 +176,30 @@ def test_truth_within_the_reported_covariance(scenario, case):
     for name in observed:
         k = reg.index(name)
         assert abs(sol.smoothed_x[0, k] - res["rows"].attrs["bias"][name]) < 3.0 * np.sqrt(sol.smoothed_P[0, k, k])
+
+
+@pytest.mark.realdata
+def test_first_pass_flies_the_shared_apriori_segments(scenario):
+    """Every fit's first sweep takes all its segments from the a priori ones flown once per set-up (it flies none),
+    and they are what a problem of its own would fly, to the last bit."""
+    sim = scenario["sim"]
+    t0, t1 = sim["t0"], sim["t1"]
+    reg = ground.registry(CFG, sim["guess"])
+    grid, steps = build_grid(reg, t0, t1, CFG["filter"]["block_s"])
+    prob = ground._problem(CFG, sim["setup"], sim["rows"].iloc[:0], reg, sim["fm"], t0, t1,
+                           ground.apriori_segments(CFG, sim))
+    _sweep(prob, grid, steps, np.zeros(grid.size, int), reg.apriori, {})
+    assert prob.n_propagations == 0 and len(prob._segments) == len(sim["apriori_segments"]) // 2 == 72
+    own = ground._problem(CFG, sim["setup"], sim["rows"].iloc[:0], reg, sim["fm"], t0, t1)
+    seg = prob._segments[40]
+    x = reg.apriori.copy()                               # the reference at the start of segment 40
+    x[np.r_[prob._state["L1"], prob._state["GEO"], prob._key_idx]] = np.concatenate(
+        [seg.trajs[sc].x_start for sc in ground.NAMES] + [seg.key])
+    _, flown, _ = own.trajectories(seg.a, x)
+    t = np.linspace(seg.a - 100.0, seg.b, 7)
+    for sc in ground.NAMES:
+        for what in ("state", "stm", "sensitivity"):
+            assert np.array_equal(getattr(flown[sc], what)(t), getattr(seg.trajs[sc], what)(t)), (sc, what)
 
 
 @pytest.mark.realdata

@@ -8,12 +8,13 @@ import pytest
 
 from odpipe.studies.scenarios import load_config
 from odpipe.dynamics.propagator import propagate
-from odpipe.estimation.fit import build_grid
+from odpipe.estimation.fit import Observations, build_grid
 from odpipe.estimation.registry import ParameterRegistry
 from odpipe.studies.halo_geo_doppler import (NAMES, R_EARTH, _rows, cases, evaluate, force_models, link_clear,
                                             simulate)
 from odpipe.measurements import MeasurementSetup, compute
 from odpipe.od.problem import TrackingProblem
+from odpipe.studies.ekf import ekf
 from odpipe.time import utc_to_tdb
 from study_runs import as_recorded, run_study, stored_figures, whole_run
 
@@ -26,8 +27,9 @@ def test_link_blocked_only_through_the_earth():
     assert list(link_clear(r1, r2)) == [False, True, True]
 
 
-@pytest.mark.realdata
-def test_simulated_doppler_equals_the_fit_reference():
+def _short_arc(offset_m=0.0):
+    """0.2 days of noise-free crosslink Doppler every 1000 s on the filter's dynamics, a priori states ``offset_m``
+    off along x: (rows kept -> TrackingProblem over them, simulated values, rows' TDB times, t0, t1)."""
     meas = MeasurementSetup.default()
     start = np.datetime64(CFG["epoch_utc"], "ns")
     t0 = float(utc_to_tdb(start))
@@ -41,11 +43,21 @@ def test_simulated_doppler_equals_the_fit_reference():
     simulated = compute(rows, truth, meas).value
     reg = ParameterRegistry()
     for sc in NAMES:
-        reg.add_state(sc, x0[sc], 100.0, 0.1)
+        reg.add_state(sc, x0[sc] + np.r_[offset_m, 0.0, 0.0, 0.0, 0.0, 0.0], 100.0, 0.1)
         reg.add_stochastic_acceleration(sc, 2e-7, 0.0, 1000.0)
     reg.add("bias.sst_doppler", "bias", 0.0, 1e-3, owner="L1", observable="sst_doppler")
     grid, _ = build_grid(reg, t0, t1, 1000.0)
-    prob = TrackingProblem(reg, rows, times, fm, meas, t0, t1, lookback=180.0, epochs=grid)
+
+    def problem(kept=slice(None)):
+        return TrackingProblem(reg, rows.iloc[kept], times[kept], fm, meas, t0, t1, lookback=180.0, epochs=grid)
+    return problem, simulated, times, t0, t1
+
+
+@pytest.mark.realdata
+def test_simulated_doppler_equals_the_fit_reference():
+    problem, simulated, _, _, _ = _short_arc()
+    prob = problem()
+    reg = prob.registry
     reference, to_los, status = prob.reference(reg.apriori)
     assert set(status) == {""}
     assert np.all(np.abs(simulated) > 100.0)                       # GEO-halo round-trip rates, m/s
@@ -53,6 +65,20 @@ def test_simulated_doppler_equals_the_fit_reference():
     # well below the X-band noise (0.1 mm/s)
     assert np.max(np.abs(reference - simulated)) < 2e-5
     assert np.allclose(to_los, 0.5)
+
+
+@pytest.mark.realdata
+def test_ekf_transitions_from_a_problem_without_rows_are_the_same():
+    """The EKF's transitions asked from a problem without rows (``dynamics``: no measurement evaluated on the
+    references flown after each update) give the same pass, to the last bit, as from the problem with the rows;
+    the a priori is 100 m off, so every update moves the reference."""
+    problem, simulated, times, t0, t1 = _short_arc(offset_m=100.0)
+    obs = Observations(times, simulated + 1e-4, np.full(times.size, 1e-4), np.zeros(times.size, int))
+    slow = ekf(problem(), obs, t0, t1, 1000.0)
+    fast = ekf(problem(), obs, t0, t1, 1000.0, dynamics=problem(slice(0)))
+    assert np.abs(slow.x[-1, :3] - slow.x[0, :3]).max() > 1.0               # the reference moved
+    for a, b in ((slow.x, fast.x), (slow.P, fast.P), (slow.postfit, fast.postfit)):
+        assert np.array_equal(a, b, equal_nan=True)
 
 
 # odpipe's Tables 4-6 for the shipped configuration (3-D RMS over the last half of the arc; seeded whole runs), as

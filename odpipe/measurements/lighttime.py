@@ -178,8 +178,8 @@ def solve_path(nodes: Sequence, t_anchor, anchor: str = "receive", t_corr=None,
         bodies = [origin_state(ephemeris, b, origin, tk) for b in shapiro_bodies]
         bpos = np.array([b[:, :3] for b in bodies]).reshape(len(bodies), n, 3)
         bvel = np.array([b[:, 3:] for b in bodies]).reshape(len(bodies), n, 3)
-        if known == i0:  # first leg: start from the instantaneous distance
-            tau = np.linalg.norm(sk[:, :3] - nodes[free].state(tk)[:, :3], axis=1) / C_LIGHT
+        if known == i0:  # first leg: from the free node's state at the anchor epoch, to second order
+            tau = _first_guess(sk[:, :3], nodes[free].state(tk), bpos, bvel, kb, direction)
         else:  # later legs start from the previous leg's light time (off by ~ v tau / c, one Newton step)
             tau = tau.copy()
         for _ in range(_MAXITER):
@@ -203,6 +203,23 @@ def solve_path(nodes: Sequence, t_anchor, anchor: str = "receive", t_corr=None,
 
     clock = np.stack([nodes[i].tdb_minus_clock(epochs[:, i], states[:, i]) for i in range(k + 1)], axis=1)
     return PathSolution(epochs, corr, states, leg_time, shapiro, clock, *_chain_partials(states, anchor))
+
+
+def _first_guess(r_known, s_free, bpos, bvel, kb, direction) -> np.ndarray:
+    """Light time (s) of a leg from the free node's state ``s_free`` at the known end's epoch: the Newton step
+    from zero, then the path's curvature in it, tau = tau_1 (1 + q tau_1 / (c - n.v)) with q = |v_perp|^2 / (2 rho)
+    (the free end moving at v over tau: rho(tau) = rho + n.v tau + q tau^2). Off by the free end's acceleration,
+    a tau^2 / 2c (4e-11 s for a cislunar leg, below the Newton tolerance), where the distance alone was off by
+    v tau / c (1.7e-5 s for a spacecraft at 30 km/s from the SSB) and took another
+    evaluation of the free node."""
+    r_rx, r_tx = (r_known, s_free[:, :3]) if direction < 0 else (s_free[:, :3], r_known)
+    v = s_free[:, 3:]
+    tau, _ = _leg_newton_step(r_rx, r_tx, v, np.zeros(len(v)), bpos, bvel, kb, direction)
+    d = r_rx - r_tx
+    rho = np.sqrt(np.einsum("ni,ni->n", d, d))
+    nv = np.einsum("ni,ni->n", d, v) / rho
+    q = 0.5 * (np.einsum("ni,ni->n", v, v) - nv * nv) / rho
+    return tau * (1.0 + q * tau / (C_LIGHT - nv))
 
 
 def _chain_partials(states: np.ndarray, anchor: str) -> tuple[np.ndarray, np.ndarray]:

@@ -12,6 +12,14 @@ at zero, with no variance) by the paper's eqs. 10-11 taken literally: before eac
 ``Gamma Q Gamma^T`` with ``Q = q I`` ((m/s^2)^2) and ``Gamma = dt [dt/2 I; I]`` over the time ``dt``
 since the previous update, on the 6 state entries from each index in ``starts`` (a gap in the data
 then gets ``dt^2`` of velocity variance, not ``dt`` times one interval's).
+
+``dynamics``: a problem over the same registry and models without rows, asked for the transitions, for
+grids whose every interval starts a new reference (spacing = the stochastic batch, as the Fujimoto
+set-up): after an update the reference from the estimate is flown again to the next epoch only, and a
+problem holding the rows (:class:`~odpipe.od.problem.TrackingProblem`) would evaluate them on it too,
+never to be read (the next interval's rows are predicted on a reference from its own epoch). The
+transitions are the same either way. With several grid intervals per batch leave it out: there the
+problem's reference from a transition serves the next interval's rows.
 """
 
 from __future__ import annotations
@@ -40,8 +48,10 @@ def gap_noise(q: float, dt: float) -> np.ndarray:
     return q * g @ g.T
 
 
-def ekf(problem, obs: Observations, t_start: float, t_end: float, block: float, gap_snc=None) -> EKFResult:
-    """One EKF pass from the registry's a priori over ``[t_start, t_end]`` with grid spacing ``block`` (s)."""
+def ekf(problem, obs: Observations, t_start: float, t_end: float, block: float, gap_snc=None,
+        dynamics=None) -> EKFResult:
+    """One EKF pass from the registry's a priori over ``[t_start, t_end]`` with grid spacing ``block`` (s);
+    transitions from ``dynamics`` when given (module doc), else from ``problem``."""
     reg = problem.registry
     if reg.n_estimated != len(reg):
         raise ValueError("ekf: consider parameters are not supported")
@@ -54,6 +64,7 @@ def ekf(problem, obs: Observations, t_start: float, t_end: float, block: float, 
         x[held], P[held, held] = 0.0, 0.0
         steps = {}
     eye = np.eye(x.size)
+    transition = (dynamics or problem).transition
     xs, Ps = [], []
     postfit = np.full(obs.time.size, np.nan)
     t_last = t_start
@@ -82,7 +93,7 @@ def ekf(problem, obs: Observations, t_start: float, t_end: float, block: float, 
             P = A @ P @ A.T + K @ R @ K.T
             x = x + dx
             postfit[rows] = y - H @ dx
-        x, Phi = problem.transition(grid[k], grid[k + 1], x)
+        x, Phi = transition(grid[k], grid[k + 1], x)
         P = Phi @ P @ Phi.T
         P = 0.5 * (P + P.T)
     xs.append(x)

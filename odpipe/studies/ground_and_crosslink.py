@@ -209,15 +209,35 @@ def registry(cfg, guess: dict) -> ParameterRegistry:
     return reg
 
 
-def fit_case(cfg, setup, rows: pd.DataFrame, guess: dict, fm: dict, t0: float, t1: float):
-    """Fit one schedule's rows; returns the odpipe Solution and the registry."""
+def _problem(cfg, setup, rows: pd.DataFrame, reg, fm: dict, t0: float, t1: float, shared=None) -> TrackingProblem:
+    """The fit's TrackingProblem over ``rows`` (``shared``: segments already flown, see TrackingProblem)."""
+    grid, _ = build_grid(reg, t0, t1, cfg["filter"]["block_s"])
+    return TrackingProblem(reg, rows, rows["time"].to_numpy(), fm, setup, t0, t1, lookback=cfg["count_time_s"] + 60.0,
+                           epochs=grid, shared=shared)
+
+
+def fit_case(cfg, setup, rows: pd.DataFrame, guess: dict, fm: dict, t0: float, t1: float, shared=None):
+    """Fit one schedule's rows (``shared``: segments already flown, e.g. :func:`apriori_segments`); returns the
+    odpipe Solution and the registry."""
     reg = registry(cfg, guess)
     opts = FitOptions(max_iter=cfg["filter"]["max_iter"], block=cfg["filter"]["block_s"])
-    grid, _ = build_grid(reg, t0, t1, opts.block)
-    times = rows["time"].to_numpy()
-    prob = TrackingProblem(reg, rows, times, fm, setup, t0, t1, lookback=cfg["count_time_s"] + 60.0, epochs=grid)
-    obs = Observations(times, rows["value"].to_numpy(float), rows["sigma"].to_numpy(float), np.zeros(len(rows), int))
+    prob = _problem(cfg, setup, rows, reg, fm, t0, t1, shared)
+    obs = Observations(prob.times, rows["value"].to_numpy(float), rows["sigma"].to_numpy(float),
+                       np.zeros(len(rows), int))
     return fit(prob, obs, t0, t1, opts), reg
+
+
+def apriori_segments(cfg, sim: dict) -> dict:
+    """The reference every schedule's fit flies first (from the a priori states and SRP scales, the stochastic
+    accelerations at zero: the same for every schedule and filter setting), flown once per set-up and kept in
+    ``sim``: a fresh copy of TrackingProblem's ``shared`` segments for each fit (its later passes add theirs)."""
+    if "apriori_segments" not in sim:
+        shared = {}
+        reg = registry(cfg, sim["guess"])
+        _problem(cfg, sim["setup"], sim["rows"].iloc[:0], reg, sim["fm"], sim["t0"], sim["t1"],
+                 shared).reference(reg.apriori)
+        sim["apriori_segments"] = shared
+    return dict(sim["apriori_segments"])
 
 
 def fit_schedule(cfg, sim: dict, case: dict, cfg_fit=None) -> dict:
@@ -231,7 +251,8 @@ def fit_schedule(cfg, sim: dict, case: dict, cfg_fit=None) -> dict:
     fits = sim.setdefault("fits", {})
     if key not in fits:
         rows = case_rows(cfg, sim["rows"], case, sim["t0"])
-        sol, reg = fit_case(cfg_fit, sim["setup"], rows, sim["guess"], sim["fm"], sim["t0"], sim["t1"])
+        sol, reg = fit_case(cfg_fit, sim["setup"], rows, sim["guess"], sim["fm"], sim["t0"], sim["t1"],
+                            apriori_segments(cfg, sim))
         fits[key] = {"solution": sol, "registry": reg, "rows": rows,
                      "metrics": position_metrics(sol, sim["truth"], sim["t0"], cfg["window_days"])}
     return fits[key]

@@ -229,11 +229,13 @@ def _fit(cfg, meas, rows, times, to_los, x0, t0, t1, estimator, known, log):
     reg = _registry(cfg, x0, known)
     fm = force_models(cfg, meas.ephemeris, "filter")
     grid, _ = build_grid(reg, t0, t1, cfg["interval_s"])
-    prob = TrackingProblem(reg, rows, times, fm, meas, t0, t1, lookback=2 * cfg["count_time_s"] + 60.0, epochs=grid)
+    prob, dynamics = (TrackingProblem(reg, rows.iloc[sel], times[sel], fm, meas, t0, t1,
+                                      lookback=2 * cfg["count_time_s"] + 60.0, epochs=grid)
+                      for sel in (slice(None), slice(0)))            # the rows, and none for the transitions
     obs = Observations(times, rows["value"].to_numpy(float), rows["sigma"].to_numpy(float), np.zeros(len(rows), int))
     starts = [reg.index(f"{sc}.x") for sc in NAMES]
     q = cfg["filter"]["snc_sigma_mps2"] ** 2
-    res = ekf(prob, obs, t0, t1, cfg["interval_s"], gap_snc=(q, starts) if gap else None)
+    res = ekf(prob, obs, t0, t1, cfg["interval_s"], gap_snc=(q, starts) if gap else None, dynamics=dynamics)
     ib = reg.index("bias.sst_doppler")
     return {"grid": res.grid, "filtered": res.x, "filtered_P": res.P, "bias": float(res.x[-1, ib] / to_los),
             "bias_sigma": float(np.sqrt(res.P[-1, ib, ib]) / to_los),
