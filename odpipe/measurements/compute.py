@@ -260,8 +260,8 @@ def spanning(setup: MeasurementSetup, t0: float, t1: float) -> MeasurementSetup:
 class Group:
     """Rows sharing one observable, unit, link (tx, rx), spacecraft (sc, sc2) and time tag, with what a model
     needs: the trajectories by spacecraft id and the set-up. ``memo``: what the group's rows alone decide (their
-    epochs, count intervals and anchor epochs), kept by :class:`Prepared` across evaluations; its arrays are
-    read-only."""
+    columns as arrays, epochs, count intervals, anchor epochs, M2, range-unit factors, media), kept by
+    :class:`Prepared` across evaluations; its arrays are read-only."""
 
     obs: str
     unit: str
