@@ -150,3 +150,21 @@ def test_a_model_registered_by_name_is_used_by_compute(setup):
     np.testing.assert_array_equal(ev_new.partials["state:A"], ev_old.partials["state:A"])
     assert set(C.MODELS) >= {"range", "doppler_2way", "doppler_3way", "doppler_1way", "angle_az", "angle_el",
                              "range_rate", "sst_range", "sst_doppler", "dowr_sum", "dowr_diff"}
+
+
+def test_rows_prepared_once_evaluate_as_fresh_rows(setup):
+    """A fit evaluates the same rows with new trajectories at every iteration from one ``prepare``: what each group
+    keeps from its rows (columns, M2, range-unit factors, media) gives, trajectory after trajectory, the values and
+    partials of a fresh ``compute`` of the rows, to the last bit."""
+    from odpipe.measurements.compute import prepare
+
+    tbl = _table()
+    tbl["media_m"] = np.linspace(1.0, 4.0, len(tbl))
+    tbl["range_modulus"] = np.where(tbl["unit"] == "RU", 2.0 ** 20, np.nan)
+    prepared = prepare(tbl)
+    for dx in (np.zeros(6), np.array([3e3, -2e3, 1e3, 0.5, -0.3, 0.2]), np.zeros(6)):
+        again, fresh = compute(tbl, _trajs(dx), setup, prepared), compute(tbl, _trajs(dx), setup)
+        assert np.array_equal(again.value, fresh.value, equal_nan=True) and np.array_equal(again.status, fresh.status)
+        assert again.partials.keys() == fresh.partials.keys()
+        for k in fresh.partials:
+            assert np.array_equal(again.partials[k], fresh.partials[k], equal_nan=True), k

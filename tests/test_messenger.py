@@ -144,6 +144,29 @@ def test_radial_hyperbola_obeys_the_energy_equation():
     assert energy == pytest.approx(0.5 * v_inf ** 2, rel=1e-9)
 
 
+def test_radial_los_is_the_line_of_sight_model_of_the_radial_approach():
+    """The search's one-pass model of many sides (distances solved once per distinct count bound) equals the
+    LineOfSight model of the same positions, side * radial_distance at each row's own t0 and t1."""
+    rng = np.random.default_rng(5)
+    t0 = np.sort(rng.choice(np.arange(0.0, 86400.0, 60.0), 300, replace=False))
+    t1 = t0 + np.where(rng.random(t0.size) < 0.5, 60.0, 30.0)   # some counts share their bounds, some do not
+    p0 = rng.normal(1e11, 1e10, (t0.size, 3))                   # station to planet, moving at ~30 km/s
+    p1 = p0 + rng.normal(0.0, 3e4, (t0.size, 3)) * (t1 - t0)[:, None]
+    los = LineOfSight(t0, t1, p0, p1, np.zeros_like(t0))
+    sides = rng.normal(size=(7, 3))
+    sides /= np.linalg.norm(sides, axis=1)[:, None]
+    t_p, v_inf = 1.5 * 86400.0, 8e3
+    got = radial_los(los, t_p, MU_VENUS, sides, v_inf)
+    zero = np.zeros((t0.size, 6, 6))
+    for s, row in zip(sides, got):
+        want, _ = los.model(s * radial_distance(t_p - t0, MU_VENUS, v_inf)[:, None],
+                            s * radial_distance(t_p - t1, MU_VENUS, v_inf)[:, None], zero, zero)
+        # the two differ by the rounding of |p + r| (~2e11 m) over a count: eps |p + r| / dt per term
+        tol = 4 * np.finfo(float).eps * np.linalg.norm(p1, axis=1).max() * 2 / (t1 - t0).min()
+        print(f"max difference {np.abs(row - want).max():.2e} m/s of {np.abs(want).max():.0f}, bound {tol:.2e}")
+        np.testing.assert_allclose(row, want, rtol=0, atol=tol)
+
+
 def test_asymptote_search_recovers_a_synthetic_approach():
     """Line-of-sight Doppler of a radial approach seen from a rotating station 0.7 AU away: the search
     best of the grid's distinct candidates, polished, is the truth (the grid alone is not: its score changes by

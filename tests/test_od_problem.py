@@ -242,3 +242,18 @@ def test_span_over_a_segment_without_rows_gives_its_transitions(case):
     x1, Phi_1 = prob.transition(epochs[0], epochs[1], reg.apriori)
     np.testing.assert_array_equal(refs[1], x1)
     assert _normalized_error(Phi[0], Phi_1) < 1e-14
+
+
+def test_remembered_stm_and_sensitivities_follow_the_epochs_asked(case):
+    """A segment remembers the STM and sensitivities of the last epochs asked (a group's partials ask for both
+    at the same events): alternating between two sets of epochs gives each set its own values, those of a
+    fresh interpolation, and the remembered arrays cannot be changed by a caller."""
+    sc, prob, x_man = case["sc"], case["prob"], case["x_man"]
+    traj = prob.segment(sc["t_man"], x_man).trajs["SC"]
+    a = np.linspace(sc["t_man"] - 50.0, sc["t_man"] + 7200.0, 7)
+    b = a[::-1] + 0.5
+    for t in (a, b, a, b):
+        _, Phi, S = traj._full(t)
+        assert np.array_equal(traj.stm(t), Phi) and np.array_equal(traj.sensitivity(t), S)
+    with pytest.raises(ValueError):
+        traj.stm(b)[0, 0, 0] = 1.0

@@ -18,6 +18,7 @@ alias listed in the catalog (e.g. ESTRACK 'NNO').
 from __future__ import annotations
 
 from dataclasses import dataclass, field
+from functools import lru_cache
 from pathlib import Path
 
 import erfa
@@ -33,6 +34,7 @@ WGS84 = 1  # ERFA ellipsoid id
 GRS80 = 2
 
 
+@lru_cache(maxsize=64)
 def _calendar_year_s(year: float) -> float:
     """Seconds past J2000 of a decimal calendar year (e.g. 2003.0 = 2003-01-01T00:00)."""
     y = int(np.floor(year))

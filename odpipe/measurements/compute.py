@@ -172,12 +172,13 @@ def compute(rows: pd.DataFrame, trajectories: Mapping, setup: MeasurementSetup,
         setup = spanning(setup, prep.span[0] - SPAN_MARGIN_S, prep.span[1] + SPAN_MARGIN_S)
     setup = _remembering(setup)
     for key, idx, g, memo in prep.groups:
+        grp = _group(key, g, trajectories, setup, memo)
         try:
-            comp, roles = _evaluate(key, g, trajectories, setup, memo)
+            comp, roles = _evaluate(grp)
         except _Unsupported as exc:
             out.status[idx] = str(exc)
             continue
-        _store(out, idx, n, comp, roles, g, setup)
+        _store(out, idx, n, comp, roles, grp)
     return out
 
 
@@ -259,8 +260,8 @@ def spanning(setup: MeasurementSetup, t0: float, t1: float) -> MeasurementSetup:
 class Group:
     """Rows sharing one observable, unit, link (tx, rx), spacecraft (sc, sc2) and time tag, with what a model
     needs: the trajectories by spacecraft id and the set-up. ``memo``: what the group's rows alone decide (their
-    epochs, count intervals and anchor epochs), kept by :class:`Prepared` across evaluations; its arrays are
-    read-only."""
+    columns as arrays, epochs, count intervals, anchor epochs, M2, range-unit factors, media), kept by
+    :class:`Prepared` across evaluations; its arrays are read-only."""
 
     obs: str
     unit: str
@@ -285,7 +286,15 @@ class Group:
 
     @property
     def epoch(self) -> np.ndarray:
-        return self._kept("epoch", lambda: self.rows["epoch"].to_numpy(dtype="datetime64[ns]", copy=True))
+        return self.column("epoch", "datetime64[ns]")
+
+    def column(self, name: str, dtype=float) -> np.ndarray:
+        """Column ``name`` of the rows as a ``dtype`` array, read once per group (read-only)."""
+        return self._kept(("column", name, np.dtype(dtype).str), lambda: self.rows[name].to_numpy(dtype, copy=True))
+
+    def has(self, name: str) -> bool:
+        """Whether the rows have column ``name``."""
+        return name in self.rows.columns
 
     def trajectory(self, sc: str):
         return _trajectory(self.trajectories, sc)
@@ -308,8 +317,7 @@ class Group:
     def interval(self):
         """Start and end (UTC) of each row's count interval."""
         def bounds():
-            s, e = interval_bounds(self.epoch.astype(np.int64), self.rows["count_time"].to_numpy(float),
-                                   self.rows["tag"].to_numpy(object))
+            s, e = interval_bounds(self.epoch.astype(np.int64), self.column("count_time"), self.column("tag", object))
             return s.astype("datetime64[ns]"), e.astype("datetime64[ns]")
         return self._kept("interval", bounds)
 
@@ -327,11 +335,15 @@ def model(*observables: str):
     return register
 
 
-def _evaluate(key, g, trajectories, setup, memo):
+def _group(key, g, trajectories, setup, memo) -> Group:
     obs, unit, tx, rx, sc, sc2, tag = key
-    if obs not in MODELS:
-        raise _Unsupported(f"observable {obs!r} has no model")
-    return MODELS[obs](Group(obs, unit, tx or rx, rx, sc, sc2, tag, g, trajectories, setup, memo))
+    return Group(obs, unit, tx or rx, rx, sc, sc2, tag, g, trajectories, setup, memo)
+
+
+def _evaluate(grp: Group):
+    if grp.obs not in MODELS:
+        raise _Unsupported(f"observable {grp.obs!r} has no model")
+    return MODELS[grp.obs](grp)
 
 
 def _receiver(grp: Group, st_rx, traj) -> dict:
@@ -342,32 +354,31 @@ def _receiver(grp: Group, st_rx, traj) -> dict:
 @model("range", "doppler_2way", "doppler_3way")
 def _dsn_two_way(grp: Group):
     """DSN two- and three-way range and ramped Doppler (Moyer)."""
-    g, setup, tx, rx, sc = grp.rows, grp.setup, grp.tx, grp.rx, grp.sc
+    setup, tx, rx, sc = grp.setup, grp.tx, grp.rx, grp.sc
     if grp.obs == "range" and grp.tag not in ("receive", "interval_end"):
         raise _Unsupported(f"range tagged {grp.tag!r}: only reception tags are modelled")
     traj = grp.trajectory(sc)
     st_tx, st_rx = setup.station(tx), setup.station(rx)
     nodes = [st_tx, setup.spacecraft(traj, sc), st_rx]
-    up = _uplink(g, tx, setup)
+    up = _uplink(grp, tx, setup)
     roles = {"station_tx": ("station", tx, st_tx), "station_rx": ("station", rx, st_rx), "spacecraft": ("sc", sc, traj)}
     if grp.obs == "range":
-        ru = range_unit_factor(g["band_up"].to_numpy(object))
-        modulus = _column(g, ("range_modulus", "range_modulus_ru"))
-        delay = np.nan_to_num(g["delay_s"].to_numpy(float)) if "delay_s" in g.columns else 0.0
+        ru = grp._kept("range_unit_factor", lambda: range_unit_factor(grp.column("band_up", object)))
+        modulus = _column(grp, ("range_modulus", "range_modulus_ru"))
+        delay = np.nan_to_num(grp.column("delay_s")) if grp.has("delay_s") else 0.0
         delay = delay - 2.0 * setup.com_offsets.get(sc, 0.0) / C_LIGHT
         if grp.unit not in ("RU", "m", "s"):
             raise _Unsupported(f"range in unit {grp.unit!r}: only RU, m and s are modelled")
-        read = g["uplink_epoch"].to_numpy("datetime64[ns]") if "uplink_epoch" in g.columns else None
+        read = grp.column("uplink_epoch", "datetime64[ns]") if grp.has("uplink_epoch") else None
         return dsn.dsn_range(grp.solve(nodes, grp.epoch), up, tx, grp.epoch, ru, grp.unit, delay, modulus,
                              read), roles
-    m2 = g["transponder_ratio"].to_numpy(float)
-    m2 = np.where(np.isfinite(m2), m2, turnaround_ratio(g["band_up"].to_numpy(object), g["band_down"].to_numpy(object)))
+    m2 = grp._kept("m2", lambda: _turnaround(grp))
     s, e, sol_s, sol_e = grp.solve_interval(nodes)
     ref = None
-    if "odf_data_type" in g.columns and g["ramped"].to_numpy(bool).all():
-        ref = g["reference_hz"].to_numpy(float)  # ODF ramped Doppler: M2 f_REF - f_received
+    if grp.has("odf_data_type") and grp.column("ramped", bool).all():
+        ref = grp.column("reference_hz")  # ODF ramped Doppler: M2 f_REF - f_received
     elif grp.obs == "doppler_3way" and setup.ramps is not None and rx in getattr(setup.ramps, "stations", []) \
-            and g["ramped"].to_numpy(bool).all():
+            and grp.column("ramped", bool).all():
         ref = setup.ramps
     return dsn.dsn_doppler(sol_s, sol_e, up, tx, s, e, m2, ref, rx), roles
 
@@ -378,8 +389,8 @@ def _one_way_doppler(grp: Group):
     g, setup, sc = grp.rows, grp.setup, grp.sc
     traj, st_rx = grp.trajectory(sc), setup.station(grp.rx)
     nodes = [setup.spacecraft(traj, sc), st_rx]
-    f_ref = g["uplink_hz"].to_numpy(float)
-    if "odf_data_type" in g.columns:  # ODF gives the one-way reference at S-band scale (parsers.odf)
+    f_ref = grp.column("uplink_hz")
+    if grp.has("odf_data_type"):  # ODF gives the one-way reference at S-band scale (parsers.odf)
         f_ref = f_ref * g["band_down"].map(lambda b: ONE_WAY_SCALE.get(band_name(b), np.nan)).to_numpy(float)
     names = oscillators.row_names(sc, g, setup.oscillators)
     known, which = np.unique(names.astype(str), return_inverse=True)
@@ -388,7 +399,7 @@ def _one_way_doppler(grp: Group):
     sols = grp.solve(nodes, s), grp.solve(nodes, e)
     proper = 0.5 * sum(proper_rate_offset(setup.ephemeris, setup.origin, p.epochs[:, 0] + p.epoch_corr[:, 0],
                                           p.states[:, 0]) for p in sols)
-    comp = dsn.one_way_doppler(*sols, f_ref, g["count_time"].to_numpy(float), y0, y1, t_ref, proper)
+    comp = dsn.one_way_doppler(*sols, f_ref, grp.column("count_time"), y0, y1, t_ref, proper)
     d = np.stack([comp.params.pop("osc_y0"), comp.params.pop("osc_y1")], 1)
     for k in dict.fromkeys(names):   # one partial group per oscillator, zero on the other rows
         comp.params[f"oscillator:{k}"] = d * (names == k)[:, None]
@@ -428,7 +439,7 @@ def _crosslink(grp: Group):
     if grp.obs == "sst_doppler":
         s, e = grp.interval()
         return crosslink.two_way_doppler(grp.solve([n1, n2, n1], s), grp.solve([n1, n2, n1], e),
-                                         grp.rows["count_time"].to_numpy(float)), roles
+                                         grp.column("count_time")), roles
     c1, c2 = setup.clocks.get(sc, crosslink.ClockModel()), setup.clocks.get(sc2, crosslink.ClockModel())
     total, diff = crosslink.dual_one_way(grp.solve([n2, n1], grp.epoch), grp.solve([n1, n2], grp.epoch), c1, c2)
     comp = total if grp.obs == "dowr_sum" else diff
@@ -438,12 +449,19 @@ def _crosslink(grp: Group):
     return comp, roles
 
 
-def _column(g, names):
-    """The first of ``names`` present in ``g`` as floats (TRK-2-34 and ODF name the range modulus differently), else NaN."""
+def _turnaround(grp: Group) -> np.ndarray:
+    """M2 per row: ``transponder_ratio`` where given, else the band pair's."""
+    m2 = grp.column("transponder_ratio")
+    return np.where(np.isfinite(m2), m2, turnaround_ratio(grp.column("band_up", object), grp.column("band_down", object)))
+
+
+def _column(grp: Group, names):
+    """The first of ``names`` present in the rows as floats (TRK-2-34 and ODF name the range modulus differently),
+    else NaN."""
     for name in names:
-        if name in g.columns:
-            return g[name].to_numpy(float)
-    return np.full(len(g), np.nan)
+        if grp.has(name):
+            return grp.column(name)
+    return np.full(len(grp.rows), np.nan)
 
 
 def _trajectory(trajectories, sc):
@@ -452,35 +470,35 @@ def _trajectory(trajectories, sc):
     return trajectories[sc]
 
 
-def _uplink(g, station, setup):
-    ramped = g["ramped"].to_numpy(bool)
+def _uplink(grp: Group, station, setup):
+    ramped = grp.column("ramped", bool)
     if ramped.any():
         if setup.ramps is None or station not in setup.ramps.stations:
             raise _Unsupported(f"ramped rows but no ramps for {station!r}")
         if not ramped.all():
             raise _Unsupported("a group mixes ramped and constant uplink rows")
         return setup.ramps
-    return ConstantUplink(g["uplink_hz"].to_numpy(float))
+    return ConstantUplink(grp.column("uplink_hz"))
 
 
-def _media(comp: Computed, g) -> np.ndarray | None:
+def _media(comp: Computed, grp: Group) -> np.ndarray | None:
     """The media column in the observable's unit, or None."""
-    if "media_m" not in g.columns:
+    if not grp.has("media_m"):
         return None
-    m = np.nan_to_num(g["media_m"].to_numpy(float))
-    obs = g["observable"].iloc[0]
-    if obs == "range":
+    m = grp._kept("media_m", lambda: np.nan_to_num(grp.column("media_m")))
+    if grp.obs == "range":
         return m / 2 / comp.to_los
-    if obs in ("doppler_2way", "doppler_3way"):
-        return m / (2 * g["count_time"].to_numpy(float)) / comp.to_los
-    if obs == "doppler_1way":
-        return m / g["count_time"].to_numpy(float) / comp.to_los
+    if grp.obs in ("doppler_2way", "doppler_3way"):
+        return m / (2 * grp.column("count_time")) / comp.to_los
+    if grp.obs == "doppler_1way":
+        return m / grp.column("count_time") / comp.to_los
     return None
 
 
-def _store(out: Evaluation, idx, n, comp: Computed, roles, g, setup):
+def _store(out: Evaluation, idx, n, comp: Computed, roles, grp: Group):
+    setup = grp.setup
     value = np.asarray(comp.value, dtype=float).copy()
-    media = _media(comp, g)
+    media = _media(comp, grp)
     if media is not None:
         _put(out, "media_scale", ["media_scale"], idx, n, media[:, None])
         if setup.media_in_model:

@@ -115,7 +115,9 @@ class StationNode:
         t = np.atleast_1d(np.asarray(t, dtype=float))
         r = self.itrs(t)
         rot = self.itrs_to_frame(t)
-        w = np.cross(np.array([0.0, 0.0, ERA_RATE]), r)
+        w = np.zeros_like(r)       # (0, 0, omega) x r
+        w[:, 0] = -ERA_RATE * r[:, 1]
+        w[:, 1] = ERA_RATE * r[:, 0]
         return np.concatenate([np.einsum("nij,nj->ni", rot, r), np.einsum("nij,nj->ni", rot, w)], axis=1)
 
     def state(self, t):

@@ -27,6 +27,7 @@ from dataclasses import dataclass, replace
 
 import numpy as np
 import pandas as pd
+from numba import njit
 from scipy.optimize import least_squares
 
 from odpipe.dynamics.forces import ForceModel
@@ -79,27 +80,55 @@ def sphere_grid(step_deg: float) -> np.ndarray:
 def radial_los(los: LineOfSight, t_p: float, mu: float, sides: np.ndarray, v_inf: float) -> np.ndarray:
     """Modelled y (K, N) m/s of the radial approaches from ``sides`` (K,3) at speed ``v_inf`` (m/s at infinity)
     reaching the centre at ``t_p``: ``|p + s rho|`` is ``sqrt(|p|² + 2 rho s.p + rho²)``."""
-    return _los_of_sides(los, _distances(los, t_p, mu, v_inf), sides @ los.p0.T, sides @ los.p1.T)
+    sight = _Sight.of(los)
+    return _sides_misfit(sight, _distances(sight, t_p, mu, v_inf), sides @ los.p0.T, sides @ los.p1.T,
+                         np.zeros(los.y.size), False)
 
 
-def _distances(los: LineOfSight, t_p: float, mu: float, v_inf: float) -> tuple:
-    """(rho0, rho1): the radial hyperbola's distances (m) at the count starts and ends of ``los``."""
-    return radial_distance(t_p - los.t0, mu, v_inf), radial_distance(t_p - los.t1, mu, v_inf)
+@dataclass
+class _Sight:
+    """What a :class:`LineOfSight` fixes for every approach tried on it: |p0|², |p1|² (m²), |p1| - |p0| (m),
+    t1 - t0 (s), and its count bounds' distinct epochs ``tau_t`` (TDB s) with ``which`` (t0 then t1 rows into
+    them: consecutive counts share a bound, so each distance is solved once)."""
+
+    pp0: np.ndarray
+    pp1: np.ndarray
+    dn: np.ndarray
+    dt: np.ndarray
+    tau_t: np.ndarray
+    which: np.ndarray
+
+    @classmethod
+    def of(cls, los: LineOfSight) -> "_Sight":
+        t, which = np.unique(np.concatenate([los.t0, los.t1]), return_inverse=True)
+        return cls(np.sum(los.p0 ** 2, 1), np.sum(los.p1 ** 2, 1),
+                   np.linalg.norm(los.p1, axis=1) - np.linalg.norm(los.p0, axis=1), los.t1 - los.t0, t, which)
 
 
-def _los_of_sides(los: LineOfSight, rho, sp0: np.ndarray, sp1: np.ndarray) -> np.ndarray:
-    """:func:`radial_los` from the distances ``rho`` = (rho0, rho1) (N,) and the products s.p0, s.p1 (K, N); the
-    products are overwritten (in place: the search's arrays are large)."""
-    rho0, rho1 = rho
-    for sp, p, r in ((sp0, los.p0, rho0), (sp1, los.p1, rho1)):
-        sp *= 2 * r
-        sp += np.sum(p ** 2, 1)
-        sp += r ** 2
-        np.sqrt(sp, out=sp)
-    sp1 -= sp0
-    sp1 -= np.linalg.norm(los.p1, axis=1) - np.linalg.norm(los.p0, axis=1)
-    sp1 /= los.t1 - los.t0
-    return sp1
+def _distances(sight: _Sight, t_p: float, mu: float, v_inf: float) -> tuple:
+    """(rho0, rho1): the radial hyperbola's distances (m) at the count starts and ends of the rows of ``sight``
+    (:func:`radial_distance` of each epoch does not depend on the others solved with it)."""
+    rho = radial_distance(t_p - sight.tau_t, mu, v_inf)[sight.which]
+    return rho[:sight.dt.size], rho[sight.dt.size:]
+
+
+def _sides_misfit(sight: _Sight, rho, sp0: np.ndarray, sp1: np.ndarray, y: np.ndarray, square: bool) -> np.ndarray:
+    """Modelled y of the sides minus ``y`` (K, N) m/s (squared when ``square``), from the distances ``rho`` =
+    (rho0, rho1) (N,) and the products s.p0, s.p1 (K, N) of the sides with the station-to-centre vectors."""
+    return _misfit_kernel(sp0, sp1, rho[0], rho[1], sight.pp0, sight.pp1, sight.dn, sight.dt, y, square)
+
+
+@njit(cache=True, error_model="numpy")
+def _misfit_kernel(sp0, sp1, rho0, rho1, pp0, pp1, dn, dt, y, square):
+    """:func:`_sides_misfit` in one pass (each element's operations in the same order as the formula's)."""
+    out = np.empty(sp0.shape)
+    for k in range(sp0.shape[0]):
+        for i in range(sp0.shape[1]):
+            n0 = np.sqrt(sp0[k, i] * (2.0 * rho0[i]) + pp0[i] + rho0[i] * rho0[i])
+            n1 = np.sqrt(sp1[k, i] * (2.0 * rho1[i]) + pp1[i] + rho1[i] * rho1[i])
+            r = ((n1 - n0) - dn[i]) / dt[i] - y[i]
+            out[k, i] = r * r if square else r
+    return out
 
 
 _SEARCH_CELLS = 1 << 16   # (side, row) cells per block of the asymptote search
@@ -116,17 +145,16 @@ def asymptote_search(los: LineOfSight, t_p: float, mu: float, sides: np.ndarray,
     centre at ``t_p``; the ``keep`` best, best first: columns sx, sy, sz, v_inf, score (trimmed RMS of y, m/s).
     The score changes by m/s within a degree: polish the best (:func:`polish_approach`)."""
     los = _usable(los, t_p)
+    sight = _Sight.of(los)
     n_use = max(1, int(round((1.0 - trim) * los.y.size)))
     chunk = max(1, _SEARCH_CELLS // max(1, los.y.size))       # sides per block: its (K, N) arrays stay in cache
     blocks = [(sides[k:k + chunk] @ los.p0.T, sides[k:k + chunk] @ los.p1.T) for k in range(0, len(sides), chunk)]
     out = []
     for v in np.atleast_1d(speeds):
-        rho = _distances(los, t_p, mu, float(v))
+        rho = _distances(sight, t_p, mu, float(v))
         score = np.empty(len(sides))
         for k, (sp0, sp1) in zip(range(0, len(sides), chunk), blocks):
-            r2 = _los_of_sides(los, rho, sp0.copy(), sp1.copy())
-            r2 -= los.y
-            r2 **= 2
+            r2 = _sides_misfit(sight, rho, sp0, sp1, los.y, True)
             score[k:k + chunk] = np.sqrt(np.partition(r2, n_use - 1, axis=1)[:, :n_use].mean(1))
         out.append(pd.DataFrame({"sx": sides[:, 0], "sy": sides[:, 1], "sz": sides[:, 2], "v_inf": float(v),
                                  "score": score}))
@@ -137,6 +165,7 @@ def polish_approach(los: LineOfSight, t_p: float, mu: float, side, v_inf: float,
     """(side (3,), v_inf m/s) of the radial approach fitted to ``los`` from a grid candidate (soft-L1 least
     squares over the side's two angles and the speed)."""
     los = _usable(los, t_p)
+    sight = _Sight.of(los)
     s = np.asarray(side, float)
 
     def unit(a):
@@ -147,9 +176,9 @@ def polish_approach(los: LineOfSight, t_p: float, mu: float, side, v_inf: float,
     def residual(a):
         v = a[2] * 1e3
         if v not in rho:
-            rho[v] = _distances(los, t_p, mu, v)
+            rho[v] = _distances(sight, t_p, mu, v)
         side = unit(a)[None, :]
-        return _los_of_sides(los, rho[v], side @ los.p0.T, side @ los.p1.T)[0] - los.y
+        return _sides_misfit(sight, rho[v], side @ los.p0.T, side @ los.p1.T, los.y, False)[0]
 
     a0 = np.array([np.arctan2(s[1], s[0]), np.arcsin(np.clip(s[2], -1, 1)), v_inf / 1e3])
     fit = least_squares(residual, a0, loss="soft_l1", f_scale=loss_scale, diff_step=1e-7)

@@ -132,6 +132,7 @@ class TrackingProblem:
         self.coarse, self._coarse = coarse, False
         self._segments: list[_Segment] = []
         self._prepared: dict = {}   # (lo, hi) -> measurements.compute.Prepared of those rows
+        self._selected: dict = {}   # (lo, hi) -> {registry index: rows of a bias or timing parameter}
         self._last = (None, None)   # (segment, x1) of the last transition, to skip re-checks
         params = registry.parameters
         bad = sorted({p.kind for p in params} - set(_SUPPORTED))
@@ -337,18 +338,20 @@ class TrackingProblem:
             G_x[sc] = ev.partials.get(f"state:{sc}", G_x[sc])
             G_p[sc] = ev.partials.get(f"dynamic:{sc}", G_p[sc])
         params = self.registry.parameters
-        columns = {col: rows[col].to_numpy() for col in _BIAS_KEYS.values() if col in rows}
+        if (lo, hi) not in self._selected:
+            columns = {col: rows[col].to_numpy() for col in _BIAS_KEYS.values() if col in rows}
+            self._selected[(lo, hi)] = {i: self._bias_rows(p, columns, m) for i, p in enumerate(params)
+                                        if p.kind in ("bias", "timing")}
+        selected = self._selected[(lo, hi)]
         if any(p.kind == "bias" for p in params):
             per_bias = (ev.partials["bias"][:, 0] if "bias" in ev.partials else np.ones(m)) \
                 / np.where(rows["unit"].to_numpy() == "rad", 1.0, ev.to_los)  # angles stay angles
         rate = tag_rate(rows, trajs, setup, ev.value) if any(p.kind == "timing" for p in params) else None
         for i, p in enumerate(params):
             if p.kind == "timing":
-                sel = self._bias_rows(p, columns, m)
-                H_lin[sel, i] = -rate[sel]
+                H_lin[selected[i], i] = -rate[selected[i]]
             elif p.kind == "bias":
-                sel = self._bias_rows(p, columns, m)
-                H_lin[sel, i] = per_bias[sel]
+                H_lin[selected[i], i] = per_bias[selected[i]]
             elif p.kind == "station" and f"station:{p.owner}" in ev.partials:
                 H_lin[:, i] = ev.partials[f"station:{p.owner}"][:, "xyz".index(p.info["axis"])]
             elif p.kind == "media" and "media_scale" in ev.partials:

@@ -84,6 +84,7 @@ class SegmentTrajectory:
                                params=list(params), first_step=self._fwd.median_step, **tol)
         self.n_eval = self._fwd.n_eval + self._back.n_eval
         self._memo: dict = {float(a): (self.x_start, np.eye(6), np.eye(6), np.zeros((6, len(self.param_names))))}
+        self._last_full = (None, None)
 
     def _pieces(self, t):
         t = np.atleast_1d(np.asarray(t, float))
@@ -121,11 +122,23 @@ class SegmentTrajectory:
 
     def stm(self, t) -> np.ndarray:
         """d x(t) / d x(a-), (N, 6, 6)."""
-        return self._full(t)[1]
+        return self._full_at(t)[1]
 
     def sensitivity(self, t) -> np.ndarray:
         """d x(t) / d params, (N, 6, p) in ``param_names`` order."""
-        return self._full(t)[2]
+        return self._full_at(t)[2]
+
+    def _full_at(self, t):
+        """:meth:`_full` at ``t``, remembered for the last epochs asked (a row group's partials ask for the STM
+        and the sensitivities at the same epochs); its arrays are read-only."""
+        t = np.atleast_1d(np.asarray(t, float))
+        key = (t.shape, t.tobytes())
+        if self._last_full[0] != key:
+            got = self._full(t)
+            for a in got:
+                a.setflags(write=False)
+            self._last_full = (key, got)
+        return self._last_full[1]
 
     def at(self, t: float) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
         """(x, Phi, Phi^-1, S) at one epoch, the state at ``a`` taken before its maneuver (Phi = I, S = 0).
@@ -171,6 +184,7 @@ class ShiftedSegmentTrajectory(SegmentTrajectory):
         self._dp = np.asarray(dp, float).copy()
         self.n_eval = 0
         self._memo = {self.t0: (self.x_start, np.eye(6), np.eye(6), np.zeros((6, len(self.param_names))))}
+        self._last_full = (None, None)
 
     def _full(self, t) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         x, Phi, S = self.base._full(t)

@@ -27,13 +27,15 @@ GM_EARTH = 3.986004415e14  # m^3/s^2
 def other_kernels() -> None:
     """One call of each kernel signature outside the demo: RK4 through the compiled force model
     (one type for every model), ``crtbp_rhs`` on writable arrays (``studies.crtbp_orbits``),
-    ``gtd7`` on writable arrays (drag and direct calls differ in array mutability) and the a priori
-    orbit search's grid kernels (``od.apriori.circular_search``, about 6 s to compile)."""
+    ``gtd7`` on writable arrays (drag and direct calls differ in array mutability), the a priori
+    orbit search's grid kernels (``od.apriori.circular_search``, about 6 s to compile) and the flyby
+    search's (``od.flyby_apriori.radial_los``, 1.5 s)."""
     from odpipe.dynamics.crtbp import crtbp_rhs
     from odpipe.dynamics.forces import ForceModel
     from odpipe.dynamics.propagator import propagate
     from odpipe.environment.atmosphere.nrlmsise00 import gtd7
-    from odpipe.od.apriori import circular_search
+    from odpipe.od.apriori import LineOfSight, circular_search
+    from odpipe.od.flyby_apriori import radial_los
 
     x0 = np.array([7.0e6, 0.0, 0.0, 0.0, 7.5e3, 0.0])
     propagate(x0, 0.0, 120.0, ForceModel("earth", central_gm=GM_EARTH), with_stm=True, method="rk4", max_step=60.0)
@@ -43,6 +45,7 @@ def other_kernels() -> None:
     u = np.tile([0.6, 0.0, 0.8], (tau.size, 1))
     circular_search(tau, np.sin(tau / 1000.0), u, 4.9e12, [6800.0], np.radians([0.0, 90.0]), np.radians([85.0, 90.0]),
                     keep=2)
+    radial_los(LineOfSight(tau, tau + 60.0, 1e11 + u, 1e11 + u, tau), 1e5, 3.2e14, u[:2], 9e3)
 
 
 def warm_worker(configs: list) -> None:
