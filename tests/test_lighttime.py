@@ -201,3 +201,20 @@ def test_first_leg_guess_is_the_exact_light_time_of_uniform_motion():
     tx, rx = _Straight(np.zeros(3), v[0]), _Straight(d, np.zeros(3))
     sol = solve_path([tx, rx], np.zeros(1), shapiro_bodies=())
     assert sol.light_time[0] == pytest.approx(exact[0], abs=1e-15) and tx.calls == 2     # guess state, one Newton
+
+
+def test_newton_step_compiles_one_signature_for_any_slice():
+    """A leg's positions and velocities arrive as column slices of (N, 6) states: strided for N > 1, contiguous
+    for N = 1. Both go through one compiled signature, with the values of contiguous copies."""
+    from odpipe.measurements.lighttime import _leg_newton_kernel, _leg_newton_step
+
+    rng = np.random.default_rng(3)
+    for n in (1, 4):
+        s_rx, s_tx = rng.normal(0.0, 1e8, (n, 6)), rng.normal(0.0, 1e8, (n, 6))
+        bpos, bvel, kb = rng.normal(0.0, 1e11, (1, n, 3)), rng.normal(0.0, 3e4, (1, n, 3)), np.array([3e3])
+        tau = np.full(n, 0.5)
+        got = _leg_newton_step(s_rx[:, :3], s_tx[:, :3], s_tx[:, 3:], tau, bpos, bvel, kb, -1)
+        want = _leg_newton_kernel(s_rx[:, :3].copy(), s_tx[:, :3].copy(), s_tx[:, 3:].copy(), tau, bpos, bvel, kb,
+                                  -1.0)
+        assert np.array_equal(got[0], want[0]) and np.array_equal(got[1], want[1])
+    assert len(_leg_newton_kernel.signatures) == 1, _leg_newton_kernel.signatures

@@ -53,3 +53,16 @@ def test_segment_state_both_sides_of_a_burn_and_shifted():
     shifted = ShiftedSegmentTrajectory(seg, x_a + dx, np.zeros(4))
     x, phi, _ = seg._full(tq)
     assert np.array_equal(shifted.state(tq), x + phi @ ((x_a + dx) - x_a))
+
+
+def test_read_only_epochs_use_the_writable_signature():
+    """Epochs from a read-only array (the measurement models' per-group memo) are interpolated as a writable
+    copy: one compiled signature of ``dense``, not a second one compiled on a fresh checkout; same values."""
+    from odpipe.dynamics.dop853 import dense
+
+    traj = propagate(X0, 0.0, 3000.0, ForceModel("earth", central_gm=GM))
+    tq = np.linspace(10.0, 2990.0, 7)
+    frozen = tq.copy()
+    frozen.flags.writeable = False
+    assert np.array_equal(traj.state(frozen), traj.state(tq))
+    assert all(sig[3].mutable for sig in dense.signatures), dense.signatures

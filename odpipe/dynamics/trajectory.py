@@ -61,7 +61,7 @@ class Trajectory:
         n = self._pieces[0][1].shape[1] if n is None else n
         if len(self._pieces) == 1:   # one integration segment (no restart inside the arc): no lookup
             ts, ys, Fs = self._pieces[0]
-            return dense(ts, ys, Fs, np.ascontiguousarray(t.ravel()), n) if len(ts) > 1 else \
+            return dense(ts, ys, Fs, np.require(t.ravel(), requirements="CW"), n) if len(ts) > 1 else \
                 np.repeat(ys[:1, :n], t.size, axis=0)
         out = np.empty((t.size, n))
         idx = np.clip(np.searchsorted(self._starts, t, side="right") - 1, 0, len(self._pieces) - 1)

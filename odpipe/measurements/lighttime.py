@@ -54,8 +54,15 @@ _MAXITER = 12
 _TOL = 1e-9  # s: a Newton step this small leaves an error below 1e-25 s (applied without re-evaluating)
 
 
-@numba.njit(cache=True)
 def _leg_newton_step(r_rx, r_tx, v_free, tau, bpos, bvel, kb, direction):
+    """:func:`_leg_newton_kernel` on C-contiguous copies where the inputs are column slices: one compiled
+    signature, whether a slice of one row (C-contiguous to numpy) or of many (strided) is passed."""
+    c = np.ascontiguousarray
+    return _leg_newton_kernel(c(r_rx), c(r_tx), c(v_free), c(tau), c(bpos), c(bvel), c(kb), float(direction))
+
+
+@numba.njit(cache=True)
+def _leg_newton_kernel(r_rx, r_tx, v_free, tau, bpos, bvel, kb, direction):
     """One Newton step for every row of a leg.
 
     r_rx, r_tx: (N,3) receiver/transmitter positions at the current iterate;
