@@ -108,9 +108,7 @@ def solve_information(R, z, n_est, c_bar, c_sigma, triangular=False) -> Gaussian
 
 def _stacked_factors(R, z, n_est):
     """Triangular factors of stacked information arrays (K, m, n), (K, m): (T_ee^-1, T_ec, T_e,z)."""
-    n = R.shape[-1]
-    T = np.linalg.qr(_augmented(R, z), mode="r")
-    return np.linalg.inv(T[:, :n_est, :n_est]), T[:, :n_est, n_est:n], T[:, :n_est, n]
+    return kernels.stacked_factors(_rows(R), _rows(z), n_est)
 
 
 def information_estimates(R, z, n_est, c_bar) -> np.ndarray:

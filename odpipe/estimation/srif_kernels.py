@@ -111,15 +111,66 @@ def absorb(R, z, H, y, w):
 
 
 @numba.njit(cache=True)
+def dynamic_rows(Phi):
+    """Rows of ``Phi`` (n, n) up to the last that differs from the identity's: ``d`` with
+    ``Phi = [[M, Q], [0, I]]``, M (d, d)."""
+    n = Phi.shape[0]
+    for i in range(n - 1, -1, -1):
+        for j in range(n):
+            if Phi[i, j] != (1.0 if i == j else 0.0):
+                return i + 1
+    return 0
+
+
+@numba.njit(cache=True)
+def unreduced_rows(A):
+    """Rows of ``A`` (m, c) up to the last with a nonzero left of its diagonal: rows from the count on are
+    already upper triangular."""
+    for i in range(A.shape[0] - 1, 0, -1):
+        for j in range(min(i, A.shape[1])):
+            if A[i, j] != 0.0:
+                return i + 1
+    return 0
+
+
+@numba.njit(cache=True)
 def mapped(R, z, Phi):
-    """``[R | z]`` of ``dx+ = Phi dx``: ``R Phi^-1`` (LAPACK gesv, as :meth:`.srif.SRIF.time_update` did)
-    re-triangularized."""
+    """``[R | z]`` of ``dx+ = Phi dx``: ``R Phi^-1`` re-triangularized. With ``Phi = [[M, Q], [0, I]]``
+    (:func:`dynamic_rows` d < n) only R's first d rows change, to ``[R11 M^-1, R12 - R11 M^-1 Q]``, and
+    reflections over those rows restore the triangle (O(d^2 n)); otherwise LAPACK gesv and a full pass."""
     n = R.shape[0]
+    d = dynamic_rows(Phi)
     A = np.empty((n, n + 1))
-    A[:, :n] = np.linalg.solve(Phi.T, R.T).T
     A[:, n] = z
-    householder(A, n)
+    if d == n:
+        A[:, :n] = np.linalg.solve(Phi.T, R.T).T
+        householder(A, n)
+    else:
+        A[:, :n] = R
+        if d > 0:
+            B = np.linalg.solve(np.ascontiguousarray(Phi[:d, :d].T), np.ascontiguousarray(R[:d, :d].T)).T
+            A[:d, :d] = B
+            A[:d, d:n] = R[:d, d:] - B @ np.ascontiguousarray(Phi[:d, d:])
+            householder(A[:d], d)
     return A[:, :n].copy(), A[:, n].copy()
+
+
+@numba.njit(cache=True)
+def stacked_factors(R, z, n_est):
+    """Triangular factors of K information arrays ``[R | z]`` (K, m, n), (K, m), m >= n_est, each reflected
+    over its :func:`unreduced_rows` only (none for the filter's triangular arrays, the first d for the
+    smoother's ``R Phi...``): (T_ee^-1 (K, n_est, n_est), T_ec (K, n_est, n - n_est), T_ez (K, n_est))."""
+    K, m, n = R.shape
+    Rinv, Rec, ze = np.empty((K, n_est, n_est)), np.empty((K, n_est, n - n_est)), np.empty((K, n_est))
+    A = np.empty((m, n + 1))
+    for k in range(K):
+        A[:, :n] = R[k]
+        A[:, n] = z[k]
+        householder(A[:unreduced_rows(A)], n)
+        Rinv[k] = upper_inverse(A[:n_est, :n_est])
+        Rec[k] = A[:n_est, n_est:n]
+        ze[k] = A[:n_est, n]
+    return Rinv, Rec, ze
 
 
 @numba.njit(cache=True)
