@@ -5,8 +5,8 @@ a reference, with ``R dx = z - nu``, ``nu ~ N(0, I)``. The vector is in registry
 canonical order: ``n_est`` estimated parameters, then consider parameters whose
 a priori (deviation ``c_bar``, sigma ``c_sigma``) is never replaced by data.
 
-Operations, all by Householder triangularization (LAPACK's reflections; the updates compiled in
-:mod:`.srif_kernels`, the rest by LAPACK geqrf):
+Operations, all by Householder triangularization (LAPACK's reflections; the updates and the stacked
+read-outs compiled in :mod:`.srif_kernels`, the rest by LAPACK geqrf):
 
 * :meth:`SRIF.measurement_update` -- rows ``H dx = y + eps``, ``eps ~ N(0, sigma^2)``;
 * :meth:`SRIF.time_update` -- deterministic map ``dx+ = Phi dx``;

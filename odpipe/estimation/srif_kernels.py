@@ -5,6 +5,10 @@ information array comes out as :func:`.srif.triangularize` gives it, up to round
 intervals of a stretch without process noise (:func:`filter_intervals`) runs in one compiled loop: per
 interval, the information array at its start is kept, its rows are tested against the filter's
 prediction (innovation k-sigma test) and absorbed, and the array is mapped to the next epoch.
+
+A transition ``[[M, Q], [0, I]]`` (a spacecraft's state rows first, constant parameters after) changes only
+the first rows of a triangular array, and the smoother's arrays ``R Phi...`` leave the triangle only there:
+the reflections then run over those rows alone (:func:`mapped`, :func:`stacked_factors`).
 """
 
 from __future__ import annotations
