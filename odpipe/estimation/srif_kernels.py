@@ -18,13 +18,16 @@ import numpy as np
 
 
 @numba.njit(cache=True)
-def householder(A, ncols):
+def householder(A, ncols, below):
     """Triangularize the first ``ncols`` columns of ``A`` (m, c) in place by Householder reflections applied
-    to every column; below-diagonal entries of those columns are set to zero."""
+    to every column; below-diagonal entries of those columns are set to zero. Rows above ``below`` are
+    taken to be zero below the diagonal already (a triangle with rows appended: ``below`` its row count;
+    0 for none), so the reflections skip them."""
     m, c = A.shape
     for j in range(min(ncols, m)):
+        first = max(j + 1, below)
         xnorm2 = 0.0
-        for i in range(j + 1, m):
+        for i in range(first, m):
             xnorm2 += A[i, j] * A[i, j]
         if xnorm2 == 0.0:
             continue
@@ -32,18 +35,18 @@ def householder(A, ncols):
         beta = -np.copysign(np.sqrt(alpha * alpha + xnorm2), alpha)
         tau = (beta - alpha) / beta
         scale = 1.0 / (alpha - beta)
-        for i in range(j + 1, m):
+        for i in range(first, m):
             A[i, j] *= scale
         A[j, j] = beta
         for col in range(j + 1, c):
             w = A[j, col]
-            for i in range(j + 1, m):
+            for i in range(first, m):
                 w += A[i, j] * A[i, col]
             w *= tau
             A[j, col] -= w
-            for i in range(j + 1, m):
+            for i in range(first, m):
                 A[i, col] -= w * A[i, j]
-        for i in range(j + 1, m):
+        for i in range(first, m):
             A[i, j] = 0.0
 
 
@@ -107,7 +110,7 @@ def absorb(R, z, H, y, w):
         for j in range(n):
             A[n + i, j] = H[i, j] * w[i]
         A[n + i, n] = y[i] * w[i]
-    householder(A, n)
+    householder(A, n, n)
     e2 = 0.0
     for i in range(n, n + m):
         e2 += A[i, n] * A[i, n]
@@ -148,14 +151,14 @@ def mapped(R, z, Phi):
     A[:, n] = z
     if d == n:
         A[:, :n] = np.linalg.solve(Phi.T, R.T).T
-        householder(A, n)
+        householder(A, n, 0)
     else:
         A[:, :n] = R
         if d > 0:
             B = np.linalg.solve(np.ascontiguousarray(Phi[:d, :d].T), np.ascontiguousarray(R[:d, :d].T)).T
             A[:d, :d] = B
             A[:d, d:n] = R[:d, d:] - B @ np.ascontiguousarray(Phi[:d, d:])
-            householder(A[:d], d)
+            householder(A[:d], d, 0)
     return A[:, :n].copy(), A[:, n].copy()
 
 
@@ -170,7 +173,7 @@ def stacked_factors(R, z, n_est):
     for k in range(K):
         A[:, :n] = R[k]
         A[:, n] = z[k]
-        householder(A[:unreduced_rows(A)], n)
+        householder(A[:unreduced_rows(A)], n, 0)
         Rinv[k] = upper_inverse(A[:n_est, :n_est])
         Rec[k] = A[:n_est, n_est:n]
         ze[k] = A[:n_est, n]
