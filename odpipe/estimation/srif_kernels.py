@@ -8,7 +8,7 @@ prediction (innovation k-sigma test) and absorbed, and the array is mapped to th
 
 A transition ``[[M, Q], [0, I]]`` (a spacecraft's state rows first, constant parameters after) changes only
 the first rows of a triangular array, and the smoother's arrays ``R Phi...`` leave the triangle only there:
-the reflections then run over those rows alone (:func:`mapped`, :func:`stacked_factors`).
+the reflections then run over those rows alone (:func:`mapped`, :func:`stacked_triangles`).
 """
 
 from __future__ import annotations
@@ -163,21 +163,42 @@ def mapped(R, z, Phi):
 
 
 @numba.njit(cache=True)
-def stacked_factors(R, z, n_est):
-    """Triangular factors of K information arrays ``[R | z]`` (K, m, n), (K, m), m >= n_est, each reflected
-    over its :func:`unreduced_rows` only (none for the filter's triangular arrays, the first d for the
-    smoother's ``R Phi...``): (T_ee^-1 (K, n_est, n_est), T_ec (K, n_est, n - n_est), T_ez (K, n_est))."""
+def stacked_triangles(R, z):
+    """K information arrays ``[R | z]`` (K, m, n), (K, m) triangularized (K, m, n + 1), each reflected over
+    its :func:`unreduced_rows` only (none for the filter's triangular arrays, the first d for the smoother's
+    ``R Phi...``)."""
     K, m, n = R.shape
-    Rinv, Rec, ze = np.empty((K, n_est, n_est)), np.empty((K, n_est, n - n_est)), np.empty((K, n_est))
-    A = np.empty((m, n + 1))
+    T = np.empty((K, m, n + 1))
     for k in range(K):
-        A[:, :n] = R[k]
-        A[:, n] = z[k]
-        householder(A[:unreduced_rows(A)], n, 0)
-        Rinv[k] = upper_inverse(A[:n_est, :n_est])
-        Rec[k] = A[:n_est, n_est:n]
-        ze[k] = A[:n_est, n]
-    return Rinv, Rec, ze
+        T[k, :, :n] = R[k]
+        T[k, :, n] = z[k]
+        householder(T[k, :unreduced_rows(T[k])], n, 0)
+    return T
+
+
+@numba.njit(cache=True)
+def stacked_upper_solve(T, b):
+    """x (K, n) of ``T[k] x[k] = b[k]``, T (K, n, n) upper triangular, by back substitution."""
+    K, n = b.shape
+    x = np.empty((K, n))
+    for k in range(K):
+        for i in range(n - 1, -1, -1):
+            if T[k, i, i] == 0.0:
+                raise np.linalg.LinAlgError("singular square-root information matrix")
+            s = b[k, i]
+            for j in range(i + 1, n):
+                s -= T[k, i, j] * x[k, j]
+            x[k, i] = s / T[k, i, i]
+    return x
+
+
+@numba.njit(cache=True)
+def stacked_upper_inverse(T):
+    """:func:`upper_inverse` of K upper-triangular matrices (K, n, n)."""
+    out = np.empty(T.shape)
+    for k in range(T.shape[0]):
+        out[k] = upper_inverse(T[k])
+    return out
 
 
 @numba.njit(cache=True)
