@@ -5,8 +5,8 @@ a reference, with ``R dx = z - nu``, ``nu ~ N(0, I)``. The vector is in registry
 canonical order: ``n_est`` estimated parameters, then consider parameters whose
 a priori (deviation ``c_bar``, sigma ``c_sigma``) is never replaced by data.
 
-Operations, all by Householder triangularization (LAPACK's reflections; the updates compiled in
-:mod:`.srif_kernels`, the rest by LAPACK geqrf):
+Operations, all by Householder triangularization (LAPACK's reflections; the updates and the stacked
+read-outs compiled in :mod:`.srif_kernels`, the rest by LAPACK geqrf):
 
 * :meth:`SRIF.measurement_update` -- rows ``H dx = y + eps``, ``eps ~ N(0, sigma^2)``;
 * :meth:`SRIF.time_update` -- deterministic map ``dx+ = Phi dx``;
@@ -107,24 +107,24 @@ def solve_information(R, z, n_est, c_bar, c_sigma, triangular=False) -> Gaussian
 
 
 def _stacked_factors(R, z, n_est):
-    """Triangular factors of stacked information arrays (K, m, n), (K, m): (T_ee^-1, T_ec, T_e,z)."""
+    """Triangular factors of stacked information arrays (K, m, n), (K, m): (T_ee, T_ec, T_e,z)."""
     n = R.shape[-1]
-    T = np.linalg.qr(_augmented(R, z), mode="r")
-    return np.linalg.inv(T[:, :n_est, :n_est]), T[:, :n_est, n_est:n], T[:, :n_est, n]
+    T = kernels.stacked_triangles(_rows(R), _rows(z))
+    return T[:, :n_est, :n_est], T[:, :n_est, n_est:n], T[:, :n_est, n]
 
 
 def information_estimates(R, z, n_est, c_bar) -> np.ndarray:
     """Estimates only (no covariance) of K stacked information arrays R (K, m, n), z (K, m), the consider part
     at ``c_bar``: (K, n)."""
-    Rinv, Rec, ze = _stacked_factors(R, z, n_est)
-    K = Rinv.shape[0]
-    xe = np.einsum("kij,kj->ki", Rinv, ze - Rec @ c_bar)
-    return np.concatenate([xe, np.broadcast_to(c_bar, (K, c_bar.size))], axis=1)
+    Ree, Rec, ze = _stacked_factors(R, z, n_est)
+    xe = kernels.stacked_upper_solve(_rows(Ree), _rows(ze - Rec @ c_bar))
+    return np.concatenate([xe, np.broadcast_to(c_bar, (xe.shape[0], c_bar.size))], axis=1)
 
 
 def solve_informations(R, z, n_est, c_bar, c_sigma) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """:func:`solve_information` of K stacked arrays at once: x (K, n), P (K, n, n), P_consider (K, n, n)."""
-    Rinv, Rec, ze = _stacked_factors(R, z, n_est)
+    Ree, Rec, ze = _stacked_factors(R, z, n_est)
+    Rinv = kernels.stacked_upper_inverse(_rows(Ree))
     K, n = Rinv.shape[0], R.shape[-1]
     x = np.concatenate([np.einsum("kij,kj->ki", Rinv, ze - Rec @ c_bar),
                         np.broadcast_to(c_bar, (K, c_bar.size))], axis=1)

@@ -5,6 +5,10 @@ information array comes out as :func:`.srif.triangularize` gives it, up to round
 intervals of a stretch without process noise (:func:`filter_intervals`) runs in one compiled loop: per
 interval, the information array at its start is kept, its rows are tested against the filter's
 prediction (innovation k-sigma test) and absorbed, and the array is mapped to the next epoch.
+
+A transition ``[[M, Q], [0, I]]`` (a spacecraft's state rows first, constant parameters after) changes only
+the first rows of a triangular array, and the smoother's arrays ``R Phi...`` leave the triangle only there:
+the reflections then run over those rows alone (:func:`mapped`, :func:`stacked_triangles`).
 """
 
 from __future__ import annotations
@@ -14,13 +18,16 @@ import numpy as np
 
 
 @numba.njit(cache=True)
-def householder(A, ncols):
+def householder(A, ncols, below):
     """Triangularize the first ``ncols`` columns of ``A`` (m, c) in place by Householder reflections applied
-    to every column; below-diagonal entries of those columns are set to zero."""
+    to every column; below-diagonal entries of those columns are set to zero. Rows above ``below`` are
+    taken to be zero below the diagonal already (a triangle with rows appended: ``below`` its row count;
+    0 for none), so the reflections skip them."""
     m, c = A.shape
     for j in range(min(ncols, m)):
+        first = max(j + 1, below)
         xnorm2 = 0.0
-        for i in range(j + 1, m):
+        for i in range(first, m):
             xnorm2 += A[i, j] * A[i, j]
         if xnorm2 == 0.0:
             continue
@@ -28,18 +35,18 @@ def householder(A, ncols):
         beta = -np.copysign(np.sqrt(alpha * alpha + xnorm2), alpha)
         tau = (beta - alpha) / beta
         scale = 1.0 / (alpha - beta)
-        for i in range(j + 1, m):
+        for i in range(first, m):
             A[i, j] *= scale
         A[j, j] = beta
         for col in range(j + 1, c):
             w = A[j, col]
-            for i in range(j + 1, m):
+            for i in range(first, m):
                 w += A[i, j] * A[i, col]
             w *= tau
             A[j, col] -= w
-            for i in range(j + 1, m):
+            for i in range(first, m):
                 A[i, col] -= w * A[i, j]
-        for i in range(j + 1, m):
+        for i in range(first, m):
             A[i, j] = 0.0
 
 
@@ -103,7 +110,7 @@ def absorb(R, z, H, y, w):
         for j in range(n):
             A[n + i, j] = H[i, j] * w[i]
         A[n + i, n] = y[i] * w[i]
-    householder(A, n)
+    householder(A, n, n)
     e2 = 0.0
     for i in range(n, n + m):
         e2 += A[i, n] * A[i, n]
@@ -111,15 +118,87 @@ def absorb(R, z, H, y, w):
 
 
 @numba.njit(cache=True)
+def dynamic_rows(Phi):
+    """Rows of ``Phi`` (n, n) up to the last that differs from the identity's: ``d`` with
+    ``Phi = [[M, Q], [0, I]]``, M (d, d)."""
+    n = Phi.shape[0]
+    for i in range(n - 1, -1, -1):
+        for j in range(n):
+            if Phi[i, j] != (1.0 if i == j else 0.0):
+                return i + 1
+    return 0
+
+
+@numba.njit(cache=True)
+def unreduced_rows(A):
+    """Rows of ``A`` (m, c) up to the last with a nonzero left of its diagonal: rows from the count on are
+    already upper triangular."""
+    for i in range(A.shape[0] - 1, 0, -1):
+        for j in range(min(i, A.shape[1])):
+            if A[i, j] != 0.0:
+                return i + 1
+    return 0
+
+
+@numba.njit(cache=True)
 def mapped(R, z, Phi):
-    """``[R | z]`` of ``dx+ = Phi dx``: ``R Phi^-1`` (LAPACK gesv, as :meth:`.srif.SRIF.time_update` did)
-    re-triangularized."""
+    """``[R | z]`` of ``dx+ = Phi dx``: ``R Phi^-1`` re-triangularized. With ``Phi = [[M, Q], [0, I]]``
+    (:func:`dynamic_rows` d < n) only R's first d rows change, to ``[R11 M^-1, R12 - R11 M^-1 Q]``, and
+    reflections over those rows restore the triangle (O(d^2 n)); otherwise LAPACK gesv and a full pass."""
     n = R.shape[0]
+    d = dynamic_rows(Phi)
     A = np.empty((n, n + 1))
-    A[:, :n] = np.linalg.solve(Phi.T, R.T).T
     A[:, n] = z
-    householder(A, n)
+    if d == n:
+        A[:, :n] = np.linalg.solve(Phi.T, R.T).T
+        householder(A, n, 0)
+    else:
+        A[:, :n] = R
+        if d > 0:
+            B = np.linalg.solve(np.ascontiguousarray(Phi[:d, :d].T), np.ascontiguousarray(R[:d, :d].T)).T
+            A[:d, :d] = B
+            A[:d, d:n] = R[:d, d:] - B @ np.ascontiguousarray(Phi[:d, d:])
+            householder(A[:d], d, 0)
     return A[:, :n].copy(), A[:, n].copy()
+
+
+@numba.njit(cache=True)
+def stacked_triangles(R, z):
+    """K information arrays ``[R | z]`` (K, m, n), (K, m) triangularized (K, m, n + 1), each reflected over
+    its :func:`unreduced_rows` only (none for the filter's triangular arrays, the first d for the smoother's
+    ``R Phi...``)."""
+    K, m, n = R.shape
+    T = np.empty((K, m, n + 1))
+    for k in range(K):
+        T[k, :, :n] = R[k]
+        T[k, :, n] = z[k]
+        householder(T[k, :unreduced_rows(T[k])], n, 0)
+    return T
+
+
+@numba.njit(cache=True)
+def stacked_upper_solve(T, b):
+    """x (K, n) of ``T[k] x[k] = b[k]``, T (K, n, n) upper triangular, by back substitution."""
+    K, n = b.shape
+    x = np.empty((K, n))
+    for k in range(K):
+        for i in range(n - 1, -1, -1):
+            if T[k, i, i] == 0.0:
+                raise np.linalg.LinAlgError("singular square-root information matrix")
+            s = b[k, i]
+            for j in range(i + 1, n):
+                s -= T[k, i, j] * x[k, j]
+            x[k, i] = s / T[k, i, i]
+    return x
+
+
+@numba.njit(cache=True)
+def stacked_upper_inverse(T):
+    """:func:`upper_inverse` of K upper-triangular matrices (K, n, n)."""
+    out = np.empty(T.shape)
+    for k in range(T.shape[0]):
+        out[k] = upper_inverse(T[k])
+    return out
 
 
 @numba.njit(cache=True)
