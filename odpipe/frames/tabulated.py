@@ -25,6 +25,11 @@ def _evaluate_many(coefs, meta, ch, t, out):
         evaluate(coefs, meta, ch, t[i], out[i])
 
 
+def node_count(t0: float, t1: float) -> int:
+    """Epochs at which a table over [t0, t1] (TDB s) evaluates the full rotation: its pieces' Chebyshev nodes."""
+    return int(np.ceil(t1 / SEGMENT_S) - np.floor(t0 / SEGMENT_S)) * (DEGREE + 1)
+
+
 class TabulatedRotation:
     """``rotation(t) -> (N, 3, 3)`` tabulated over ``[t0, t1]`` (TDB s); outside it, an error."""
 

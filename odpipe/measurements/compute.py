@@ -56,7 +56,7 @@ import pandas as pd
 
 from odpipe.constants import C_LIGHT, SECONDS_PER_DAY
 from odpipe.environment.ephemeris import SpanEphemeris
-from odpipe.frames.tabulated import TabulatedRotation
+from odpipe.frames.tabulated import TabulatedRotation, node_count
 from odpipe.tracking.timetags import interval_bounds
 
 from . import angles, crosslink, dsn, instantaneous, oscillators, refraction
@@ -169,7 +169,7 @@ def compute(rows: pd.DataFrame, trajectories: Mapping, setup: MeasurementSetup,
     n = len(prep.rows)
     out = Evaluation(np.full(n, np.nan), np.full(n, np.nan), np.full(n, "", dtype=object), {}, {})
     if prep.span is not None:
-        setup = spanning(setup, prep.span[0] - SPAN_MARGIN_S, prep.span[1] + SPAN_MARGIN_S)
+        setup = spanning(setup, prep.span[0] - SPAN_MARGIN_S, prep.span[1] + SPAN_MARGIN_S, n)
     setup = _remembering(setup)
     for key, idx, g, memo in prep.groups:
         grp = _group(key, g, trajectories, setup, memo)
@@ -243,15 +243,19 @@ def _remembering(setup: MeasurementSetup) -> MeasurementSetup:
 
 
 SPAN_MARGIN_S = SECONDS_PER_DAY  # s around the rows' epochs: light times (hours) and count intervals
+ROTATION_EPOCHS_PER_ROW = 12     # Earth-orientation epochs a row asks for: up to 3 events x 4 light-time iterations
 
 
-def spanning(setup: MeasurementSetup, t0: float, t1: float) -> MeasurementSetup:
+def spanning(setup: MeasurementSetup, t0: float, t1: float, n_rows: int | None = None) -> MeasurementSetup:
     """``setup`` tabulated over [t0, t1] TDB s: ephemeris from Chebyshev pieces (:class:`SpanEphemeris`),
-    Earth orientation from a Chebyshev table (:class:`TabulatedRotation`). Parts already tabulated are kept."""
+    Earth orientation from a Chebyshev table (:class:`TabulatedRotation`). Parts already tabulated are kept.
+    With ``n_rows``, the Earth orientation is tabulated only if those rows would ask for it at more epochs than
+    the table's nodes (a few rows a month apart: each epoch computed directly, not a month of hourly pieces)."""
     eph, rot = setup.ephemeris, setup.gcrs_to_itrs
     if hasattr(eph, "interpolant") and not isinstance(eph, SpanEphemeris):
         eph = SpanEphemeris(eph, t0, t1)
-    if rot is not None and not isinstance(rot, TabulatedRotation):
+    sparse = n_rows is not None and n_rows * ROTATION_EPOCHS_PER_ROW < node_count(t0, t1)
+    if rot is not None and not isinstance(rot, TabulatedRotation) and not sparse:
         rot = TabulatedRotation(rot, t0, t1)
     return replace(setup, ephemeris=eph, gcrs_to_itrs=rot)
 
