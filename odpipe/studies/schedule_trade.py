@@ -83,8 +83,8 @@ def run(cfg: dict, out, log=print, sim: dict | None = None) -> dict:
     offset = pd.DataFrame(offset)
     simultaneous = offset[offset.ground_offset_h == 0]
     shifted = offset[(offset.ground_offset_h > 0) | (offset.liaison_gap_h == 0)]
-    panels = [{"title": f"{sc}: equal gaps, ground simultaneous vs offset by half a gap (cf. Fig. 8.9)",
-               "t_days": None,
+    panels = [{"title": f"{sc}: ground simultaneous or offset by half the gap (cf. Fig. 8.9)",
+               "t_days": None, "xlabel": "gap between passes, LiAISON = ground (h)",
                "curves": [(f"{what} {kind}", d[f"{sc} {col}"].to_numpy(),
                            {"t": d["liaison_gap_h"].to_numpy(), "color": color, "ls": ls, "marker": "o", "ms": 3})
                           for kind, d, color in (("simultaneous", simultaneous, "C0"), ("offset", shifted, "C3"))

@@ -49,7 +49,8 @@ def write_markdown(out: Path, title: str, sections: list[tuple[str, str]]) -> Pa
 
 def plot_convergence(out: Path, name: str, panels: list[dict], ylabel: str, ncols: int = 2) -> Path:
     """One log-scale panel per dict {title, t_days, curves: [(label, values, style)]}, ncols per row;
-    a style's 't' overrides the panel's t_days for that curve."""
+    a style's 't' overrides the panel's t_days for that curve, a panel's 'xlabel' the default "time (days)".
+    Titles share the panel's width (about 70 characters at 5 in)."""
     import matplotlib
 
     matplotlib.use("Agg")
@@ -68,7 +69,7 @@ def plot_convergence(out: Path, name: str, panels: list[dict], ylabel: str, ncol
             ax.semilogy(p["t_days"] if "t" not in style else style["t"], y,
                         **{k: v for k, v in style.items() if k != "t"}, label=label)
         ax.set_title(p["title"], fontsize=9)
-        ax.set_xlabel("time (days)")
+        ax.set_xlabel(p.get("xlabel", "time (days)"))
         ax.grid(True, which="both", alpha=0.3)
     for row in axes:
         row[0].set_ylabel(ylabel)
