@@ -52,6 +52,31 @@ def test_example2_one_way_with_frequency_offset(kvn):
     assert (ramp["station"], ramp["freq_hz"], ramp["rate_hz_s"]) == ("yyyy-nnnA", 32023442781.733, 0.0)
 
 
+@pytest.mark.parametrize("syntax", ["kvn", "xml"])
+def test_example2_one_way_becomes_doppler_against_the_spacecraft_frequency(kvn, xmlf, syntax):
+    """The fit's reading (odpipe.products.tdm.doppler_from_tdm): the received frequency is RECEIVE_FREQ_1 +
+    FREQ_OFFSET, the one-way Doppler the spacecraft's TRANSMIT_FREQ_2 less it (Hz, positive receding)."""
+    from odpipe.products.tdm import doppler_from_tdm
+
+    d, left = doppler_from_tdm(tdm.read(kvn("TDMExample2.txt") if syntax == "kvn" else xmlf("TDMExample2.xml")))
+    t = d.table
+    assert left == 0 and list(t["observable"]) == ["doppler_1way"] * 6
+    received = 32021035200.0 + np.array([-409.2735, -371.1568, -333.0551, -294.9673, -256.9054, -218.7951])
+    assert np.allclose(t["value"], 32023442781.733 - received, rtol=0, atol=1e-5)
+    assert set(t["uplink_hz"]) == {32023442781.733} and set(t["spacecraft"]) == {"yyyy-nnnA"}
+    assert set(t["station_rx"]) == {"DSS-25"} and set(t["station_tx"]) == {""}
+
+
+def test_example6_five_leg_received_frequency_stays_as_read(kvn):
+    """PATH 1,2,3,2,1 with an unnumbered RECEIVE_FREQ: no link the Doppler models know, kept as received."""
+    from odpipe.products.tdm import doppler_from_tdm
+
+    d, left = doppler_from_tdm(tdm.read(kvn("TDMExample6.txt")))
+    rf = d.table[d.table["keyword"] == "RECEIVE_FREQ"]
+    assert left == 0 and len(rf) == 4 and set(rf["observable"]) == {"receive_freq"} and set(rf["value"]) == {2287487999.0}
+    assert not d.table["keyword"].str.startswith("TRANSMIT_FREQ").any() and len(d.ramps) == 4
+
+
 def test_example4_range_in_range_units_and_ramps(kvn):
     d = tdm.read(kvn("TDMExample4.txt"))
     t = d.table

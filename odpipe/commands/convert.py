@@ -38,6 +38,12 @@ def run(args) -> int:
 
     data = load(args.input, args.errors)  # a ParseError, or a file with no tracking data: the CLI's one line
     if suffix == ".parquet":
+        if data.meta.get("format") == "TDM":   # the fit's observables: Doppler, the ramps beside the table
+            from odpipe.products.tdm import doppler_from_tdm
+
+            data, left = doppler_from_tdm(data)
+            if left:
+                print(f"{left} RECEIVE_FREQ rows kept as received frequency (no reference to make Doppler of)")
         written = store.write(args.output, data.table, data.ramps)
     else:
         from odpipe.products.tdm import to_tdm

@@ -13,8 +13,8 @@ range              two/three-way range, ``unit`` 'RU', 'm' or 's', tagged at rec
                    gives the range-unit factor; uplink from the ramp store when ``ramped``,
                    else ``uplink_hz``; optional columns ``range_modulus`` or ``range_modulus_ru`` (RU), ``delay_s``.
 doppler_2way/3way  count-averaged Doppler (Hz), interval from ``epoch``/``tag``/``count_time``;
-                   M2 = ``transponder_ratio`` or the band pair's. Reference f_R: ramped ODF rows
-                   use the record's ``reference_hz`` (constant); other ramped three-way rows the
+                   M2 = ``transponder_ratio`` or the band pair's. Reference f_R: ramped rows with
+                   a ``reference_hz`` (ODF, TDM FREQ_OFFSET) use it (constant); other ramped three-way rows the
                    receiver's own ramp when the store has it; else the transmitter's uplink.
 doppler_1way       f_ref = ``uplink_hz`` (ODF rows: times 880/240 for X, 3344/240 for Ka downlinks, as
                    the ODF gives it at S-band scale, row by row); each row's oscillator from
@@ -379,8 +379,8 @@ def _dsn_two_way(grp: Group):
     m2 = grp._kept("m2", lambda: _turnaround(grp))
     s, e, sol_s, sol_e = grp.solve_interval(nodes)
     ref = None
-    if grp.has("odf_data_type") and grp.column("ramped", bool).all():
-        ref = grp.column("reference_hz")  # ODF ramped Doppler: M2 f_REF - f_received
+    if grp.has("reference_hz") and grp.column("ramped", bool).all() and np.isfinite(grp.column("reference_hz")).all():
+        ref = grp.column("reference_hz")  # ODF (or TDM FREQ_OFFSET) ramped Doppler: M2 f_REF - f_received
     elif grp.obs == "doppler_3way" and setup.ramps is not None and rx in getattr(setup.ramps, "stations", []) \
             and grp.column("ramped", bool).all():
         ref = setup.ramps

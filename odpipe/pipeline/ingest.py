@@ -1,13 +1,14 @@
 """Ingest: read every tracking file of a run into one TrackingTable and one ramp table.
 
-Each file's format is detected (:mod:`parsers.formats`); a ``.parquet`` file
-is a TrackingTable the project wrote itself (:mod:`odpipe.preprocess.store`,
-ramps beside it), so any stage's output can feed a run. In ``errors="report"``
-mode a corrupt record is reported with its file and offset and skipped; a file
-no reader recognises is reported and skipped; nothing else is lost. Files that
-name no spacecraft (Orekit's ``.aer`` tables) have their rows given the run's.
-A process keeps the last few files it read (keyed by path, size and modification
-time), so the arcs of a nightly that share a day's file parse it once per worker.
+Each file's format is detected (:mod:`parsers.formats`); a ``.parquet`` file is a TrackingTable the
+project wrote itself (:mod:`odpipe.preprocess.store`, ramps beside it), so any stage's output can
+feed a run. In ``errors="report"`` mode a corrupt record is reported with its file and offset and
+skipped; a file no reader recognises is reported and skipped; nothing else is lost. A CCSDS TDM's
+received frequencies become DSN Doppler against its FREQ_OFFSET or TRANSMIT_FREQ lines
+(:func:`odpipe.products.tdm.doppler_from_tdm`). Files that name no spacecraft (Orekit's ``.aer``
+tables) have their rows given the run's. A process keeps the last few files it read (keyed by path,
+size and modification time), so the arcs of a nightly that share a day's file parse it once per
+worker.
 """
 
 from __future__ import annotations
@@ -18,6 +19,7 @@ from pathlib import Path
 import pandas as pd
 
 from odpipe.preprocess import store as table_store
+from odpipe.products.tdm import doppler_from_tdm
 from parsers import ParseError, TrackingData
 from parsers.formats import read_any
 from parsers.ramps import RampStore
@@ -72,6 +74,10 @@ def ingest(files: list[Path], errors: str = "report", spacecraft: str = "") -> I
         if not hasattr(data, "table"):
             log.append(f"SKIPPED {path}: not a tracking file")
             continue
+        data, left = doppler_from_tdm(data)   # a TDM's received frequencies: DSN Doppler
+        if left:
+            log.append(f"{path.name}: {left} RECEIVE_FREQ rows kept as received frequency (no FREQ_OFFSET or"
+                       " TRANSMIT_FREQ reference to make Doppler of)")
         tables.append(data.table)
         if data.ramps is not None and len(data.ramps):
             ramps.append(data.ramps)

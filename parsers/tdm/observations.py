@@ -6,10 +6,12 @@ Rows keep the TDM ``keyword``, ``segment`` (index), ``line`` (in the file),
 the file. Values are SI (see :mod:`parsers.tdm.keywords`). Tags: integrated types
 (DOPPLER_INTEGRATED, DOPPLER_COUNT, RECEIVE_FREQ*) follow INTEGRATION_REF and have
 ``count_time`` = INTEGRATION_INTERVAL; the others follow TIMETAG_REF (default receive).
-Stations: a ``..._n`` keyword belongs to PARTICIPANT_n; other rows go from the first to
-the last participant of PATH (or PATH_1). TRANSMIT_FREQ_n rows (with TRANSMIT_FREQ_RATE_n
-at the same epoch, else rate 0) also make the ramp table, and rows transmitted by a
-station that has ramps are marked ``ramped``.
+Stations: a ``..._n`` keyword belongs to PARTICIPANT_n; other rows go from the first to the last
+participant of PATH (or PATH_1). ``RECEIVE_FREQ_n`` of the path's last participant was sent by the
+first of a three-participant PATH (1,2,1 or 1,2,3); ``spacecraft`` is the middle one of such a PATH,
+or the sender of a two-participant one (one-way down), else ''. TRANSMIT_FREQ_n rows (with
+TRANSMIT_FREQ_RATE_n at the same epoch, else rate 0) also make the ramp table, and rows transmitted
+by a station that has ramps are marked ``ramped``.
 """
 
 from __future__ import annotations
@@ -62,11 +64,18 @@ def _segment_rows(seg: Segment, index: int, first: int, path, errors, report: Pa
     path_ = [int(p) for p in meta.get("PATH", meta.get("PATH_1", "0")).split(",")]
     tx = np.full(n, participants.get(path_[0], ""), dtype=object)
     rx = np.full(n, participants.get(path_[-1], ""), dtype=object)
+    spacecraft = np.full(n, participants.get(path_[1], "") if len(path_) == 3 else "", dtype=object)
     for key in set(keys):
         p = kw.participant(key)
         if p is not None:
-            (tx if key.startswith("TRANSMIT") else rx)[keys == key] = participants[p]
-            (rx if key.startswith("TRANSMIT") else tx)[keys == key] = ""
+            sel = keys == key
+            (tx if key.startswith("TRANSMIT") else rx)[sel] = participants[p]
+            (rx if key.startswith("TRANSMIT") else tx)[sel] = ""
+            if key.startswith("RECEIVE") and p == path_[-1]:  # the path's receiver: its transmitter is the path's
+                if len(path_) == 3:                            # first (1,2,1 or 1,2,3); one-way down (2,1): none
+                    tx[sel] = participants.get(path_[0], "")
+                elif len(path_) == 2:
+                    spacecraft[sel] = participants.get(path_[0], "")
     integrated = np.isin(keys, list(kw.INTEGRATED))
     tag = np.where(integrated, _REF.get(meta.get("INTEGRATION_REF"), "interval_mid"),
                    _TAG[meta.get("TIMETAG_REF", "RECEIVE")])
@@ -75,7 +84,7 @@ def _segment_rows(seg: Segment, index: int, first: int, path, errors, report: Pa
     modulus = np.where(keys == "RANGE", _number(meta, "RANGE_MODULUS") * factor, np.nan)
     scale = meta["TIME_SYSTEM"]
     return tt.build(n, epoch=times.to_utc(epochs, scale), tag=tag, observable=observable, value=values * factor,
-                    unit=unit, count_time=count_time, station_tx=tx, station_rx=rx,
+                    unit=unit, count_time=count_time, station_tx=tx, station_rx=rx, spacecraft=spacecraft,
                     band_up=meta.get("TRANSMIT_BAND", ""), band_down=meta.get("RECEIVE_BAND", ""),
                     transponder_ratio=num / den if den else np.nan, record=record, flags=0,
                     keyword=keys, segment=np.int64(index), line=lines, time_system=scale,
