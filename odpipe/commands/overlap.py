@@ -4,6 +4,7 @@ from __future__ import annotations
 
 from pathlib import Path
 
+from odpipe.commands._values import number
 from odpipe.errors import Exit
 
 NAME = "overlap"
@@ -13,7 +14,7 @@ HELP = "overlap precision (RIC, 3D RMS) between consecutive arcs' OEM solutions"
 def add_arguments(p):
     p.add_argument("oem", nargs="+", type=Path, help="OEM files of consecutive arcs, in arc order (at least two)")
     p.add_argument("-o", "--out", type=Path, default=Path("overlap"), help="output folder")
-    p.add_argument("--step", type=float, default=600.0, help="comparison grid step (s)")
+    p.add_argument("--step", type=number(), default=600.0, help="comparison grid step (s)")
 
 
 def _labels(paths) -> list[str]:
@@ -31,8 +32,6 @@ def run(args) -> int:
 
     if len(args.oem) < 2:
         raise ValueError(f"odpipe overlap needs at least two OEM files, got {len(args.oem)}")
-    if not args.step > 0:
-        raise ValueError(f"--step {args.step}: must be positive (s)")
     trajs = [oem_trajectory(p) for p in args.oem]
     names = _labels(args.oem)
     overlaps = [compare(a, b, f"{na} - {nb}", args.step)
