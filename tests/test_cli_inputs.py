@@ -1,7 +1,9 @@
 """The step commands' bad inputs, as a user types them: numeric options out of range, an arc that ends
-before it starts. Each is one line naming the option, exit status 2 (before these checks a count time
-of 0 or a negative gap ran with exit 0, and inf was an internal error)."""
+before it starts, corrupt and empty files. Each is one line naming the option or the file, exit status 2
+(before these checks a count time of 0 or a negative gap ran with exit 0, and inf was an internal error)."""
 
+import subprocess
+import sys
 from pathlib import Path
 
 import pytest
@@ -58,6 +60,26 @@ def test_edit_refuses_an_arc_that_ends_before_it_starts(table, tmp_path, capsys)
     assert main(["edit", str(table), "-o", str(tmp_path / "e.parquet"), "--no-elevation-mask",
                  "--arc", "2016-03-02", "2016-03-01"]) == 2
     assert capsys.readouterr().err.strip() == "error: --arc: END 2016-03-01 is not after START 2016-03-02"
+
+
+def test_a_corrupt_parquet_file_is_one_line_naming_it_once(tmp_path, capsys):
+    """Parquet magic at both ends, nothing valid between: pyarrow's text named the file a second time."""
+    bad = tmp_path / "bad.parquet"
+    bad.write_bytes(b"PAR1garbagePAR1")
+    for command in (["inspect", str(bad)], ["compress", str(bad), "-o", str(tmp_path / "c.parquet")],
+                    ["edit", str(bad), "-o", str(tmp_path / "e.parquet"), "--no-elevation-mask"]):
+        assert main(command) == 2
+        (line,) = capsys.readouterr().err.strip().splitlines()
+        assert line.startswith(f"error: {bad}: not a readable Parquet file (") and line.count(str(bad)) == 1, line
+
+
+def test_an_empty_file_is_said_to_be_empty(tmp_path):
+    """As a user runs it: `odpipe inspect` and `odpipe convert` on a file of 0 bytes."""
+    empty = tmp_path / "empty.odf"
+    empty.write_bytes(b"")
+    for args in (["inspect", str(empty)], ["convert", str(empty), "-o", str(tmp_path / "x.parquet")]):
+        out = subprocess.run([sys.executable, "-m", "odpipe.cli", *args], capture_output=True, text=True, cwd=ROOT)
+        assert out.returncode == 2 and out.stderr == f"error: {empty}: empty file (0 bytes)\n", out.stderr
 
 
 @pytest.mark.realdata
