@@ -147,7 +147,7 @@ def report_tables(stats: pd.DataFrame) -> list[tuple[str, pd.DataFrame, dict]]:
             t[f"post-fit RMS ({unit})"] = sub["postfit_rms_obs"]
         fmt = {c: significant for c in t.columns if "RMS" in c}
         places = decimals(np.min(sub["postfit_rms"] / np.sqrt(sub["n_used"])) * scale)  # the mean's standard error
-        fmt[f"post-fit mean ({shown})"] = lambda v, p=places: f"{round(v, p) + 0.0:.{p}f}"   # + 0.0: no "-0.00"
+        fmt[f"post-fit mean ({shown})"] = f"{{:.{places}f}}"   # a mean rounded to zero: html_table drops its sign
         out.append((f"{obs}" + (f" (observed in {unit})" if unit else ""), t, fmt))
     return out
 
