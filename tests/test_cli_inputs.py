@@ -82,6 +82,12 @@ def test_an_empty_file_is_said_to_be_empty(tmp_path):
         assert out.returncode == 2 and out.stderr == f"error: {empty}: empty file (0 bytes)\n", out.stderr
 
 
+def test_maneuvers_of_a_folder_that_does_not_exist(tmp_path, capsys):
+    """It said 'no maneuvers.csv (did the run estimate maneuvers?)' of a mistyped run folder."""
+    assert main(["maneuvers", str(tmp_path / "runs" / "typo")]) == 2
+    assert capsys.readouterr().err.strip() == f"error: {tmp_path / 'runs' / 'typo'}: No such file or directory"
+
+
 @pytest.mark.realdata
 @pytest.mark.parametrize("option, value, reason", [("--span", "-1", "-1.0 must be positive and finite"),
                                                    ("--degree", "1", "1 must be at least 2")])
