@@ -72,7 +72,8 @@ def test_summary_mean_and_std_over_overlaps(tmp_path):
 @pytest.mark.parametrize("n", [1, 3, 9])
 def test_overlap_plot_keeps_long_arc_names_inside_the_figure(monkeypatch, n):
     """The GRAIL night's names ('grail_b_2012_04_08 - grail_b_2012_04_09', 30° slanted) ran off the
-    figure's left and bottom edges, the x label with them: every text's box lies inside the figure."""
+    figure's left and bottom edges, the x label with them: every text's box lies inside the figure, and
+    the legend on no bar."""
     import parsers.atomic
 
     saved = []
@@ -88,6 +89,8 @@ def test_overlap_plot_keeps_long_arc_names_inside_the_figure(monkeypatch, n):
     for t in texts:
         box = t.get_window_extent()
         assert box.x0 >= 0 and box.y0 >= 0 and box.x1 <= fig.bbox.x1 and box.y1 <= fig.bbox.y1, (t.get_text(), box)
+    legend = ax.get_legend().get_window_extent()   # it hid the top of the tallest bars
+    assert not any(legend.overlaps(bar.get_window_extent()) for bar in ax.patches)
 
 
 def test_arcs_that_do_not_overlap_are_refused():

@@ -239,6 +239,9 @@ def plot_overlaps(summary: pd.DataFrame, path, kind: str = "pos", title: str = "
     ax.set_ylabel(f"RMS difference ({unit})")
     ax.set_xlabel("overlap (arc A − arc B)")
     ax.set_title(title or ("Position" if kind == "pos" else "Velocity") + " overlap differences", y=1.0)
-    ax.legend()
+    top = float(np.nanmax(rows[cols].to_numpy(float))) * scale if len(rows) else 0.0
+    if top > 0:
+        ax.set_ylim(0, 1.25 * top)   # headroom: the one-row legend above the tallest bar, not on it
+    ax.legend(ncol=4, loc="upper center")
     ax.grid(axis="y", alpha=0.3)
     save_figure(path, fig, dpi=110)
