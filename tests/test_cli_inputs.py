@@ -96,3 +96,23 @@ def test_apriori_options_are_checked_as_the_configuration_is(capsys, option, val
     negative span was 'zero-size array to reduction operation', a negative degree 'negative dimensions')."""
     assert main(["apriori", str(ROOT / "runs" / "grail_b_2012_04_09_start.toml"), option, value]) == 2
     assert capsys.readouterr().err.strip() == f"error: {option}: {reason}"
+
+
+def test_overlap_command_prints_its_means_to_three_figures(tmp_path, capsys):
+    """Three straight-line arcs offset 0, 100 and 300 m cross-track (overlaps of 100 and 200 m, a known
+    difference): `odpipe overlap` printed '150.000 ± 70.711 m' and velocities to 1e-4 mm/s; the mean to 3
+    significant figures now, the standard deviation to the same decimals."""
+    import numpy as np
+
+    from odpipe.products.oem import write_oem
+    from odpipe.products.segments import EphemerisSegment
+
+    t = 4e8 + np.arange(0.0, 7201.0, 60.0)
+    x = np.column_stack([7e6 + 0 * t, 7.5e3 * (t - t[0]), 0 * t, 0 * t, 7.5e3 + 0 * t, 0 * t])
+    paths = []
+    for k, (lo, hi) in enumerate([(0, 80), (40, 121), (80, 121)]):
+        shifted = x[lo:hi] + [0, 0, (0.0, 100.0, 300.0)[k], 0, 0, 0]
+        paths.append(str(write_oem(tmp_path / f"a{k}.oem", [EphemerisSegment(t[lo:hi], shifted)], "SC", "-1")))
+    assert main(["overlap", *paths, "-o", str(tmp_path / "out"), "--step", "60"]) == 0
+    line = capsys.readouterr().out.splitlines()[0]
+    assert line == "2 overlaps; position 3D RMS 150 ± 71 m, velocity 3D RMS 0.00 ± 0.00 mm/s", line

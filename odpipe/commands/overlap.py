@@ -42,7 +42,15 @@ def run(args) -> int:
     plot_overlaps(table, args.out / "overlap_position.png", "pos")
     plot_overlaps(table, args.out / "overlap_velocity.png", "vel")
     mean, std = table.iloc[-2], table.iloc[-1]
-    print(f"{len(overlaps)} overlaps; position 3D RMS {mean.pos_3d_rms:.3f} ± {std.pos_3d_rms:.3f} m, "
-          f"velocity 3D RMS {mean.vel_3d_rms * 1e3:.4f} ± {std.vel_3d_rms * 1e3:.4f} mm/s")
+    print(f"{len(overlaps)} overlaps; position 3D RMS {_spread(mean.pos_3d_rms, std.pos_3d_rms)} m, "
+          f"velocity 3D RMS {_spread(mean.vel_3d_rms * 1e3, std.vel_3d_rms * 1e3)} mm/s")
     print(f"table and plots in {args.out}/")
     return Exit.OK
+
+
+def _spread(mean: float, std: float) -> str:
+    """'mean ± std': the mean to 3 significant figures, the standard deviation to the same decimals."""
+    from odpipe.operations.report import significant
+
+    shown = significant(mean)
+    return f"{shown} ± {std:.{len(shown.partition('.')[2])}f}"
