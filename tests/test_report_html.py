@@ -292,7 +292,8 @@ def test_overlap_and_maneuver_tables_keep_the_rules():
                             Section("m").tables(maneuver_report.report_tables(rows, stats, np.array(
                                 ["2003-06-03T00:00:00", "2003-06-04T00:00:00"], "datetime64[ns]")))])
     assert broken_rules(page) == []
-    assert utc_iso(t[0]) in page and "2.000" in page  # the second overlap's position RMS, mm digits
+    assert utc_iso(t[0]) in page and "<td>2.00</td>" in page  # the second overlap's position RMS, 3 figures
+    assert "<td>2.000</td>" not in page and "<td>1.50</td>" in page   # and their mean
     assert "\u2013" in page  # an undefined percentage shows as a dash
 
 

@@ -137,8 +137,10 @@ def summarize(overlaps: list[Overlap]) -> pd.DataFrame:
 
 def report_tables(table: pd.DataFrame) -> list[tuple[str, pd.DataFrame, dict]]:
     """(caption, table, formats) of a :func:`summarize` table for a report: per overlap its span (UTC)
-    and the RIC RMS, 3D RMS and 3D maximum differences, position in m and velocity in mm/s to the
-    mm and µm/s; then the mean and standard deviation over the overlaps, without the span columns."""
+    and the RIC RMS, 3D RMS and 3D maximum differences, position in m and velocity in mm/s, each to 3
+    significant figures as the run reports' statistics (GRAIL-B's 566.818 m showed its mm); then the mean
+    and standard deviation over the overlaps, without the span columns."""
+    from odpipe.operations.report import significant
     from odpipe.time import tdb_to_utc
 
     each = table[~table["overlap"].isin(["mean", "std"])]
@@ -152,7 +154,7 @@ def report_tables(table: pd.DataFrame) -> list[tuple[str, pd.DataFrame, dict]]:
     for kind, what, scale, unit in (("pos", "position", 1.0, "m"), ("vel", "velocity", 1e3, "mm/s")):
         for key, name in names.items():
             figures[f"{what} {name} ({unit})"] = table[f"{kind}_{key}"] * scale
-    formats = {c: "{:.3f}" for c in figures.columns[1:]} | {"duration (h)": "{:.1f}"}
+    formats = {c: significant for c in figures.columns[1:]} | {"duration (h)": "{:.1f}"}
     stats = figures[figures["overlap"].isin(["mean", "std"])].rename(columns={"overlap": "statistic"})
     return [("per overlap", pd.concat([out, figures.loc[each.index].drop(columns="overlap")], axis=1), formats),
             ("over all overlaps", stats, formats)]
