@@ -42,9 +42,16 @@ def detect(path) -> str | None:
     return None
 
 
+def unrecognised(path) -> ParseError:
+    """The error for a file no reader recognises: an empty one said so (a truncated copy, a failed download)."""
+    if Path(path).stat().st_size == 0:
+        return ParseError(Path(path), "empty file (0 bytes)")
+    return ParseError(Path(path), f"format not recognised (readers available: {', '.join(available())})")
+
+
 def read_any(path, errors: str = "raise"):
     """Read ``path`` with the reader that recognises it; ParseError when none does."""
     name = detect(path)
     if name is None:
-        raise ParseError(Path(path), f"format not recognised by any of {available()}")
+        raise unrecognised(path)
     return importlib.import_module(name).read(path, errors=errors)

@@ -74,6 +74,33 @@ def read_ionex(*paths, errors: str = "raise", report: ParseReport | None = None)
                      [s for p in parts for s in p.sources])
 
 
+def sniff(head: bytes) -> bool:
+    """True when the first line is the IONEX VERSION / TYPE header record."""
+    first = head.decode("latin-1").split("\n", 1)[0]
+    return first[60:80].rstrip() == "IONEX VERSION / TYPE"
+
+
+def read(path, errors: str = "raise") -> IonexMaps:
+    """The maps of one file (the reader interface of :mod:`parsers.formats`)."""
+    return read_ionex(path, errors=errors)
+
+
+def describe(path) -> list[str]:
+    """Lines for ``odpipe inspect``: maps, their epochs and interval, the grid, and the maps left out."""
+    report = ParseReport()
+    m = read_ionex(path, errors="report", report=report)
+    lines = [f"TEC maps: {len(m.epochs)}" + (", with RMS maps" if m.rms is not None else "")]
+    if len(m.epochs):
+        lines.append(f"epochs: {np.datetime64(m.epochs[0], 's')} .. {np.datetime64(m.epochs[-1], 's')} UTC, "
+                     f"every {m.interval_s:g} s")
+    lines += [f"grid: latitude {m.lat_deg[0]:g} .. {m.lat_deg[-1]:g} deg ({m.lat_deg.size}), longitude "
+              f"{m.lon_deg[0]:g} .. {m.lon_deg[-1]:g} deg ({m.lon_deg.size}), height "
+              + ", ".join(f"{h / 1e3:g}" for h in m.height_m) + " km",
+              f"mapping function: {m.mapping_function}, elevation cutoff {m.elevation_cutoff_deg:g} deg",
+              f"maps left out: {len(report)}"]
+    return lines + [f"  {e}" for e in list(report)[:5]]
+
+
 MAX_GRID = 100_000  # points along one axis; more is not a map but a hostile header
 
 

@@ -196,6 +196,41 @@ def read_trk223(*paths, errors: str = "raise", report: ParseReport | None = None
     return CalibrationSet(cards)
 
 
+def sniff(head: bytes) -> bool:
+    """True when the first line that is not a comment starts an ADJUST card."""
+    first = next((s for s in (ln.strip() for ln in head.decode("latin-1").splitlines()) if s and s[0] != "#"), "")
+    return first.upper().startswith("ADJUST(")
+
+
+def read(path, errors: str = "raise") -> "CalibrationSet":
+    """The cards of one file (the reader interface of :mod:`parsers.formats`)."""
+    return read_trk223(path, errors=errors)
+
+
+def describe(path) -> list[str]:
+    """Lines for ``odpipe inspect``: cards per model and complex or station list, their span, spacecraft
+    ids, and what was unreadable."""
+    report = ParseReport()
+    cards = read_trk223(path, errors="report", report=report).cards
+    lines = [f"cards: {len(cards)}"]
+    for model in MODELS:
+        mine = [c for c in cards if c.model == model]
+        if not mine:
+            continue
+        nets = {}
+        for c in mine:
+            nets[c.network] = nets.get(c.network, 0) + 1
+        closed = [t for c in mine for t in (c.start, c.end) if _OPEN_START < t < _OPEN_END]
+        span = (f"{np.datetime64(min(closed), 's')} .. {np.datetime64(max(closed), 's')} UTC" if closed
+                else "open")
+        lines.append(f"{model}: {len(mine)} cards, " + ", ".join(f"{n} {k}" for n, k in sorted(nets.items()))
+                     + f"; {span}")
+    scids = sorted({c.scid for c in cards if c.scid >= 0})
+    if scids:
+        lines.append("spacecraft (SCID): " + ", ".join(map(str, scids)))
+    return lines + [f"unreadable records: {len(report)}"] + [f"  {e}" for e in list(report)[:5]]
+
+
 class CalibrationSet:
     """TRK-2-23 cards, evaluated vectorized at UTC times (``datetime64[ns]``)."""
 

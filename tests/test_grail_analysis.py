@@ -117,6 +117,26 @@ def test_diagnosis_names_a_bad_ramp_segment():
     assert table.loc["DSS-54", "segment_offset_mm_s"] == pytest.approx(3.0, abs=0.5)
 
 
+def test_diagnosis_summary_says_which_rule_a_station_exceeds():
+    """The start arc's case: every station near 3 mm/s stands out by the 2-mm/s limit, not by the median
+    (a sentence 'stands out (0.9 times the stations' median)' alone contradicts itself); a station 3 times
+    the others' RMS stands out by the median."""
+    from odpipe.analysis.station_diagnostics import summary
+
+    rng = np.random.default_rng(6)
+    rows = pd.concat([_smooth_station(rng, s, amp=4e-3) for s in ("DSS-24", "DSS-54", "DSS-65")], ignore_index=True)
+    table = diagnose(rows)
+    assert table["stands_out"].all() and (table["rms_mm_s"] < 1.5 * table["rms_mm_s"].median()).all()
+    text = summary(table)
+    assert text.count("above 2 mm/s; ") == 3, text
+    rows = pd.concat([_smooth_station(rng, s, amp=3e-4) for s in ("DSS-24", "DSS-54")]
+                     + [_smooth_station(rng, "DSS-65", amp=1e-3)], ignore_index=True)
+    table = diagnose(rows)
+    assert table.set_index("station")["stands_out"].tolist() == [False, False, True]
+    text = summary(table)
+    assert "DSS-65 stands out (" in text and "above" not in text and "times the stations' median)" in text, text
+
+
 class _Line:
     """A trajectory on a straight line (m, m/s) plus a fixed offset, over [0, 3600] s."""
 

@@ -33,6 +33,32 @@ def test_detect_formats_of_real_files(shared_data, tmp_path):
         assert formats.detect(shared_data / rel) == name, rel
 
 
+@pytest.mark.realdata
+def test_inspect_reads_calibration_files(shared_data, capsys):
+    """README: `odpipe inspect` says what a calibration file holds, too. Cassini's TRK-2-23 cards and the
+    IGS-format IONEX day, counted in the raw text: the model named in each card's MODEL(...), its
+    DSN(...) complex; the IONEX file's START OF TEC MAP records and its header's grid."""
+    import re
+
+    tro = shared_data / "cassini" / "S18TIGE2006_032_2006_059.TRO"
+    ion = shared_data / "cassini" / "S19TIGE2006_060_2006_090.ION"
+    ionex = shared_data / "ionex" / "gpsg0150.19i"
+    lines = inspect_lines(capsys, tro, ion, ionex)
+    for path in (tro, ion):
+        cards = re.findall(r"MODEL\s*\(([A-Z ]+)\)\s*FROM.*?DSN\((C\d0)\)", " ".join(path.read_text().split()))
+        assert f"cards: {len(cards)}" in lines
+        for model in {m for m, _ in cards}:
+            per = Counter(c for m, c in cards if m == model)
+            assert any(ln.startswith(f"{model}: {sum(per.values())} cards, "
+                                     + ", ".join(f"{c} {n}" for c, n in sorted(per.items())) + ";")
+                       for ln in lines), (model, per)
+    assert "format: parsers.trk223" in lines and "spacecraft (SCID): 82" in lines   # Cassini's DSN id
+    text = ionex.read_text()
+    assert f"TEC maps: {text.count('START OF TEC MAP')}" in lines and "format: parsers.ionex" in lines
+    assert "epochs: 2019-01-15T00:00:00 .. 2019-01-16T00:00:00 UTC, every 3600 s" in lines   # its header's
+    assert "grid: latitude 87.5 .. -87.5 deg (71), longitude -180 .. 180 deg (73), height 350 km" in lines
+
+
 def test_inspect_unknown_and_unreadable_inputs(tmp_path, capsys):
     (tmp_path / "notes.txt").write_text("nothing to see here\n")
     assert formats.detect(tmp_path / "notes.txt") is None

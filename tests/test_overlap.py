@@ -1,6 +1,7 @@
 """Overlap statistics on synthetic trajectories whose differences are known in closed form."""
 
 import numpy as np
+import pandas as pd
 import pytest
 
 from odpipe.analysis.overlap import (PiecewiseTrajectory, SampledTrajectory, compare, long_arc_schedule,
@@ -66,6 +67,30 @@ def test_summary_mean_and_std_over_overlaps(tmp_path):
     assert mean == pytest.approx(20.0, abs=1e-6) and std == pytest.approx(10.0, abs=1e-6)
     plot_overlaps(table, tmp_path / "pos.png", "pos")
     assert (tmp_path / "pos.png").read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
+
+
+@pytest.mark.parametrize("n", [1, 3, 9])
+def test_overlap_plot_keeps_long_arc_names_inside_the_figure(monkeypatch, n):
+    """The GRAIL night's names ('grail_b_2012_04_08 - grail_b_2012_04_09', 30° slanted) ran off the
+    figure's left and bottom edges, the x label with them: every text's box lies inside the figure, and
+    the legend on no bar."""
+    import parsers.atomic
+
+    saved = []
+    monkeypatch.setattr(parsers.atomic, "save_figure", lambda path, fig, **kw: saved.append(fig))
+    names = [f"grail_b_2012_04_{k:02d} - grail_b_2012_04_{k + 1:02d}" for k in range(8, 8 + n)]
+    cols = [f"{q}_{c}_rms" for q in ("pos", "vel") for c in ("radial", "intrack", "crosstrack", "3d")]
+    plot_overlaps(pd.DataFrame({"overlap": names, **{c: np.linspace(1.0, 500.0, n) for c in cols}}), "x.png", "pos")
+    fig = saved[0]
+    fig.canvas.draw()
+    ax = fig.axes[0]
+    texts = ax.get_xticklabels() + [ax.xaxis.label, ax.yaxis.label, ax.title]
+    assert [t.get_text() for t in ax.get_xticklabels()] == names
+    for t in texts:
+        box = t.get_window_extent()
+        assert box.x0 >= 0 and box.y0 >= 0 and box.x1 <= fig.bbox.x1 and box.y1 <= fig.bbox.y1, (t.get_text(), box)
+    legend = ax.get_legend().get_window_extent()   # it hid the top of the tallest bars
+    assert not any(legend.overlaps(bar.get_window_extent()) for bar in ax.patches)
 
 
 def test_arcs_that_do_not_overlap_are_refused():

@@ -127,3 +127,26 @@ def test_edit_summary_adds_up_with_the_residual_tables(res):
     stats = statistics(res)
     assert rows["fitted"] == stats["n_used"].sum() and rows["edited (innovation test)"] == stats["n_edited"].sum()
     assert rows["passed to the fit"] == table.loc[table["stage"] == "fit", "rows"].sum()
+
+
+def test_a_station_has_one_colour_in_every_panel(monkeypatch):
+    """GRAIL-B 04-08's pre-fit plot: one-way from DSS-14, -24, -34, -65 and two-way from DSS-24, -27, -34, -65;
+    DSS-24 was orange in the one-way panel and blue in the two-way one (each panel's own colour cycle)."""
+    import odpipe.products.residuals as residuals
+
+    saved = []
+    monkeypatch.setattr(residuals, "save_figure", lambda path, fig, **kw: saved.append(fig))
+    panels = {"doppler_1way": ("DSS-14", "DSS-24", "DSS-34", "DSS-65"),
+              "doppler_2way": ("DSS-24", "DSS-27", "DSS-34", "DSS-65")}
+    rows = pd.DataFrame([{"station_rx": st, "observable": obs, "band": "S",
+                          "epoch": np.datetime64("2012-04-08T06:00", "ns") + np.timedelta64(60 * k, "s"),
+                          "postfit_los": 1e-3 * (-1) ** k, "flags": 0, "status": ""}
+                         for obs, stations in panels.items() for st in stations for k in range(5)])
+    residuals.plot(rows, "x.png", "postfit")
+    colours = {}
+    for ax in saved[0].axes:
+        for line in ax.get_lines():
+            colours.setdefault(line.get_label().split(" (")[0], set()).add(line.get_color())
+    assert set(colours) == {"DSS-14", "DSS-24", "DSS-27", "DSS-34", "DSS-65"}
+    assert all(len(c) == 1 for c in colours.values()), colours
+    assert len(set().union(*colours.values())) == 5   # and the stations apart

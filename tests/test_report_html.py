@@ -73,6 +73,7 @@ def broken_rules(page: str) -> list[str]:
     out += [f"TDB seconds: {c!r}" for c in cells.td if TDB_SECONDS.search(c)]
     out += [f"TDB time column: {h!r}" for h in cells.th if "tdb" in h.lower()]
     out += [f"not ISO UTC: {c!r}" for c in cells.td if DATE_LIKE.search(c) and not ISO.match(c)]
+    out += [f"negative zero: {c!r}" for c in cells.td if re.fullmatch(r"-0(\.0*)?", c)]
     if not cells.th:
         out.append("no table")
     return out
@@ -80,8 +81,17 @@ def broken_rules(page: str) -> list[str]:
 
 def test_the_rules_catch_what_the_old_reports_showed():
     old = ("<table><tr><th>t_start_tdb</th><th>postfit_rms</th></tr>"
-           "<tr><td>3.43955e+08</td><td>nan</td></tr><tr><td>2010-11-23 13:00:00</td><td>1</td></tr></table>")
-    assert len(broken_rules(old)) == 6
+           "<tr><td>3.43955e+08</td><td>nan</td></tr><tr><td>2010-11-23 13:00:00</td><td>-0.0</td></tr></table>")
+    assert len(broken_rules(old)) == 7
+
+
+def test_a_value_rounded_to_zero_has_no_sign():
+    """The GRAIL start arc's station diagnostics showed a timing offset of '-0.0' ms (-0.04 at 0.1)."""
+    from odpipe.operations.report import html_table
+
+    page = html_table(pd.DataFrame({"timing offset (ms)": [-0.04, -0.06, 0.0, -0.0], "rows": [0, 1, 2, 3]}),
+                      {"timing offset (ms)": "{:.1f}"})
+    assert broken_rules(page) == [] and "<td>-0.1</td>" in page and page.count("<td>0.0</td>") == 3
 
 
 F_ONE_WAY = 8.4e9            # Hz: an X-band oscillator
@@ -282,7 +292,8 @@ def test_overlap_and_maneuver_tables_keep_the_rules():
                             Section("m").tables(maneuver_report.report_tables(rows, stats, np.array(
                                 ["2003-06-03T00:00:00", "2003-06-04T00:00:00"], "datetime64[ns]")))])
     assert broken_rules(page) == []
-    assert utc_iso(t[0]) in page and "2.000" in page  # the second overlap's position RMS, mm digits
+    assert utc_iso(t[0]) in page and "<td>2.00</td>" in page  # the second overlap's position RMS, 3 figures
+    assert "<td>2.000</td>" not in page and "<td>1.50</td>" in page   # and their mean
     assert "\u2013" in page  # an undefined percentage shows as a dash
 
 

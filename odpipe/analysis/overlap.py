@@ -137,8 +137,10 @@ def summarize(overlaps: list[Overlap]) -> pd.DataFrame:
 
 def report_tables(table: pd.DataFrame) -> list[tuple[str, pd.DataFrame, dict]]:
     """(caption, table, formats) of a :func:`summarize` table for a report: per overlap its span (UTC)
-    and the RIC RMS, 3D RMS and 3D maximum differences, position in m and velocity in mm/s to the
-    mm and µm/s; then the mean and standard deviation over the overlaps, without the span columns."""
+    and the RIC RMS, 3D RMS and 3D maximum differences, position in m and velocity in mm/s, each to 3
+    significant figures as the run reports' statistics (GRAIL-B's 566.818 m showed its mm); then the mean
+    and standard deviation over the overlaps, without the span columns."""
+    from odpipe.operations.report import significant
     from odpipe.time import tdb_to_utc
 
     each = table[~table["overlap"].isin(["mean", "std"])]
@@ -152,7 +154,7 @@ def report_tables(table: pd.DataFrame) -> list[tuple[str, pd.DataFrame, dict]]:
     for kind, what, scale, unit in (("pos", "position", 1.0, "m"), ("vel", "velocity", 1e3, "mm/s")):
         for key, name in names.items():
             figures[f"{what} {name} ({unit})"] = table[f"{kind}_{key}"] * scale
-    formats = {c: "{:.3f}" for c in figures.columns[1:]} | {"duration (h)": "{:.1f}"}
+    formats = {c: significant for c in figures.columns[1:]} | {"duration (h)": "{:.1f}"}
     stats = figures[figures["overlap"].isin(["mean", "std"])].rename(columns={"overlap": "statistic"})
     return [("per overlap", pd.concat([out, figures.loc[each.index].drop(columns="overlap")], axis=1), formats),
             ("over all overlaps", stats, formats)]
@@ -206,7 +208,8 @@ def long_arc_schedule(maneuvers_tdb, margin_s: float = 3600.0):
 
 def plot_overlaps(summary: pd.DataFrame, path, kind: str = "pos", title: str = "") -> None:
     """Bar chart per overlap of the R, I, C and 3D RMS differences (thesis Figs. 4.10–4.13), on a bare Agg
-    figure (no pyplot; fixed margins instead of a tight layout's extra draw)."""
+    figure (no pyplot). Margins (inches) are sized from the longest overlap name, measured by the renderer
+    without drawing (a tight layout's extra draw): the 30°-slanted names and the x label fit the figure."""
     from matplotlib.backends.backend_agg import FigureCanvasAgg
     from matplotlib.figure import Figure
 
@@ -218,15 +221,29 @@ def plot_overlaps(summary: pd.DataFrame, path, kind: str = "pos", title: str = "
     scale, unit = (1.0, "m") if kind == "pos" else (1e3, "mm/s")
     x = np.arange(len(rows))
     fig = Figure(figsize=(8, 4))
-    FigureCanvasAgg(fig)
-    fig.subplots_adjust(left=0.1, right=0.98, top=0.92, bottom=0.3)
+    canvas = FigureCanvasAgg(fig)
     ax = fig.subplots()
     for k, (label, col) in enumerate(zip(labels, cols)):
         ax.bar(x + (k - 1.5) * 0.2, rows[col] * scale, width=0.2, label=label)
     ax.set_xticks(x, rows["overlap"], rotation=30, ha="right")
+    ax.set_xlim(-0.5, len(rows) - 0.5)
+    measure = canvas.get_renderer().get_text_width_height_descent
+    w, h = np.max([measure(str(t.get_text()), t.get_fontproperties(), ismath=False)[:2] for t in ax.get_xticklabels()]
+                  or [[0, 0]],
+                  axis=0) / fig.dpi   # inches, unrotated
+    wide, tall = w * np.cos(np.pi / 6) + h * np.sin(np.pi / 6), w * np.sin(np.pi / 6) + h * np.cos(np.pi / 6)
+    first = 0.5 / max(len(rows), 1)   # the first tick's place along the axes (fraction of their width)
+    width, right, top, plot_h, bottom = 8.0, 0.15, 0.35, 2.8, tall + 0.45   # inches; 0.45: ticks, x label
+    left = max(0.8, (wide + 0.1 - (width - right) * first) / (1 - first))
+    fig.set_size_inches(width, top + plot_h + bottom)
+    fig.subplots_adjust(left=left / width, right=1 - right / width, top=1 - top / (top + plot_h + bottom),
+                        bottom=bottom / (top + plot_h + bottom))
     ax.set_ylabel(f"RMS difference ({unit})")
     ax.set_xlabel("overlap (arc A − arc B)")
     ax.set_title(title or ("Position" if kind == "pos" else "Velocity") + " overlap differences", y=1.0)
-    ax.legend()
+    top = float(np.nanmax(rows[cols].to_numpy(float))) * scale if len(rows) else 0.0
+    if top > 0:
+        ax.set_ylim(0, 1.25 * top)   # headroom: the one-row legend above the tallest bar, not on it
+    ax.legend(ncol=4, loc="upper center")
     ax.grid(axis="y", alpha=0.3)
     save_figure(path, fig, dpi=110)

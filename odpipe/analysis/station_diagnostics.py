@@ -36,6 +36,7 @@ import pandas as pd
 from scipy.special import chdtri  # chi-square inverse survival function (scipy.stats costs ~1 s to import)
 
 SIGNATURES = ("timing", "troposphere", "pass_bias")
+FACTOR, MAX_RMS = 1.5, 2e-3   # a station stands out above FACTOR times the stations' median RMS, or MAX_RMS (m/s)
 
 
 def rows_used(residuals: pd.DataFrame, tracking: pd.DataFrame, ramps: pd.DataFrame | None = None,
@@ -169,8 +170,8 @@ def _significant(p: pd.DataFrame, p_false: float = 0.01) -> bool:
     return bool(np.sum((p["estimate"] / p["sigma"]) ** 2) > chdtri(len(p), p_false))
 
 
-def diagnose(rows: pd.DataFrame, min_explained: float = 0.5, min_z: float = 6.0, factor: float = 1.5,
-             max_rms: float = 2e-3, params: pd.DataFrame | None = None) -> pd.DataFrame:
+def diagnose(rows: pd.DataFrame, min_explained: float = 0.5, min_z: float = 6.0, factor: float = FACTOR,
+             max_rms: float = MAX_RMS, params: pd.DataFrame | None = None) -> pd.DataFrame:
     """One line per station: RMS (mm/s), whether it stands out, each signature's explained fraction, the
     estimated timing offset (ms) and troposphere scale, the worst ramp segment's offset (mm/s) and z, what
     the fit's own time-offset and pass-bias parameters took (:func:`estimated_terms`, from ``params``), and
@@ -218,16 +219,21 @@ CAUSES = {"timing": "a time-tag offset", "troposphere": "a troposphere (low-elev
           "none": "none found: smooth, field-like residuals"}
 
 
-def summary(table: pd.DataFrame) -> str:
-    """One sentence per standing-out station (or that none stands out) for a report."""
+def summary(table: pd.DataFrame, factor: float = FACTOR, max_rms: float = MAX_RMS) -> str:
+    """One sentence per standing-out station (or that none stands out) for a report, saying which of
+    :func:`diagnose`'s rules (``factor`` times the median, ``max_rms`` in m/s) it exceeds."""
     out = table[table["stands_out"].astype(bool)]
     taken = table[table["likely_cause"].str.endswith("_estimated") & ~table["stands_out"].astype(bool)]
     said = " ".join(f"{r.station}'s residuals were explained by {CAUSES[r.likely_cause]}." for r in taken.itertuples())
     if not len(out):
         return " ".join(["No station stands out.", said]).strip()
     median = table["rms_mm_s"].median()
-    return said + (" " if said else "") + " ".join(f"{r.station} stands out ({r.rms_mm_s:.2f} mm/s, {r.rms_mm_s / median:.1f} times the stations' "
-                    f"median); likely cause: {CAUSES[r.likely_cause]}." for r in out.itertuples())
+
+    def why(rms: float) -> str:
+        ratio = f"{rms / median:.1f} times the stations' median"
+        return ratio if rms > factor * median else f"above {max_rms * 1e3:g} mm/s; {ratio}"
+    return said + (" " if said else "") + " ".join(f"{r.station} stands out ({r.rms_mm_s:.2f} mm/s, {why(r.rms_mm_s)}); "
+                                                   f"likely cause: {CAUSES[r.likely_cause]}." for r in out.itertuples())
 
 
 # the likely cause in a report table's cell: short, the summary above the table says it in full (CAUSES)

@@ -32,8 +32,9 @@ def read_table(path):
                          "(make one from a tracking file with `odpipe convert FILE -o OUT.parquet`)")
     try:
         return store.read(path)
-    except ValueError as err:     # pyarrow's ArrowInvalid is a ValueError too
-        raise ValueError(f"{path}: {err}") from None
+    except ValueError as err:     # pyarrow's ArrowInvalid is a ValueError too; its text repeats the path
+        reason = str(err).split(f"{path}': ", 1)[-1]
+        raise ValueError(f"{path}: not a readable Parquet file ({reason})") from None
 
 
 def add_geometry_arguments(parser) -> None:

@@ -2,7 +2,7 @@
 
 from __future__ import annotations
 
-from dataclasses import replace
+from dataclasses import fields, replace
 from pathlib import Path
 
 import numpy as np
@@ -26,8 +26,14 @@ def run(args) -> int:
 
     cfg = load_config(args.config)
     how = cfg.initial_state.from_doppler or DopplerAprioriSection()
-    how = replace(how, **{k: v for k, v in (("station", args.station), ("span_hours", args.span),
-                                             ("degree", args.degree)) if v is not None})
+    given = {k: (option, v) for k, option, v in (("station", "--station", args.station),
+                                                 ("span_hours", "--span", args.span),
+                                                 ("degree", "--degree", args.degree)) if v is not None}
+    for f in fields(how):   # the configuration's own checks of [initial_state.from_doppler]
+        if f.name in given and "check" in f.metadata:
+            for _, reason in f.metadata["check"](given[f.name][1]):
+                raise ValueError(f"{given[f.name][0]}: {reason}")
+    how = replace(how, **{k: v for k, (_, v) in given.items()})
     res, rows = doppler_apriori(cfg, how)
     el = res.elements
     print(f"# {len(rows)} 60-s two-way Doppler points of {rows['station_rx'].iloc[0]}, "

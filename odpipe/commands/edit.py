@@ -12,6 +12,7 @@ import logging
 import numpy as np
 
 from odpipe.commands._inputs import add_geometry_arguments, read_table, select_spacecraft, utc_times, with_geometry
+from odpipe.commands._values import number
 from odpipe.preprocess import store
 from odpipe.preprocess.edit import EditConfig, edit
 
@@ -26,10 +27,11 @@ def add_arguments(parser) -> None:
     d = EditConfig()
     parser.add_argument("--min-elevation", type=float, default=np.degrees(d.min_elevation),
                         help="elevation mask, deg (elevation from --trajectory or the 'elevation_rx' column)")
-    parser.add_argument("--blunder-k", type=float, default=d.blunder_k, help="robust sigmas of the detrended signal")
-    parser.add_argument("--gross-k", type=float, default=d.gross_k, help="robust sigmas of a pass's values")
-    parser.add_argument("--min-pass-samples", type=int, default=d.min_pass_samples)
-    parser.add_argument("--max-gap", type=float, default=d.max_gap, help="pass break at gaps longer than this, s")
+    parser.add_argument("--blunder-k", type=number(), default=d.blunder_k, help="robust sigmas of the detrended signal")
+    parser.add_argument("--gross-k", type=number(), default=d.gross_k, help="robust sigmas of a pass's values")
+    parser.add_argument("--min-pass-samples", type=number(int), default=d.min_pass_samples,
+                        help="passes with fewer rows are flagged short_pass")
+    parser.add_argument("--max-gap", type=number(), default=d.max_gap, help="pass break at gaps longer than this, s")
     parser.add_argument("--arc", nargs=2, metavar=("START", "END"), help="fit arc, UTC ISO times")
     parser.add_argument("--no-elevation-mask", action="store_true",
                         help="edit without the elevation mask (when no geometry is known; logged)")
@@ -40,6 +42,8 @@ def run(args) -> int:
     table, ramps = read_table(args.input)
     table = select_spacecraft(table, args, args.input)
     arc = utc_times(args.arc, "--arc") if args.arc else None
+    if arc is not None and not arc[1] > arc[0]:
+        raise ValueError(f"--arc: END {args.arc[1]} is not after START {args.arc[0]}")
     if args.no_elevation_mask:
         if args.trajectory:
             raise ValueError("--no-elevation-mask and --trajectory contradict each other: give one")

@@ -11,7 +11,7 @@ from parsers import formats
 from parsers.errors import ParseReport
 from parsers.table import TrackingData
 from odpipe.errors import Exit, describe
-from odpipe.preprocess import store
+from odpipe.commands._inputs import read_table
 from odpipe.tracking import ramp_segments
 from odpipe.preprocess.edit import duplicates, invalid
 from odpipe.tracking.passes import assign_passes
@@ -67,11 +67,11 @@ def report_lines(report: ParseReport) -> list[str]:
 def summarize(path) -> list[str]:
     """Lines describing one file."""
     if str(path).endswith(".parquet"):
-        table, ramps = store.read(path)
+        table, ramps = read_table(path)
         return ["format: TrackingTable Parquet"] + tracking_summary(TrackingData(table, ramps))
     name = formats.detect(path)
     if name is None:
-        raise ValueError(f"{path}: format not recognised (readers available: {', '.join(formats.available())})")
+        raise formats.unrecognised(path)
     report = ParseReport()
     mod = importlib.import_module(name)
     if hasattr(mod, "describe"):  # a reader of something other than tracking data (CPF, SINEX)

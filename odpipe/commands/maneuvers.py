@@ -22,6 +22,8 @@ def run(args) -> int:
 
     tables = []
     for path in args.runs:
+        if not path.exists():
+            raise FileNotFoundError(2, "No such file or directory", str(path))
         csv = path / "maneuvers.csv" if path.is_dir() else path
         if not csv.is_file():
             raise ValueError(f"{path}: no maneuvers.csv (did the run estimate maneuvers?)")

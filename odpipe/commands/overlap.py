@@ -4,6 +4,7 @@ from __future__ import annotations
 
 from pathlib import Path
 
+from odpipe.commands._values import number
 from odpipe.errors import Exit
 
 NAME = "overlap"
@@ -13,7 +14,7 @@ HELP = "overlap precision (RIC, 3D RMS) between consecutive arcs' OEM solutions"
 def add_arguments(p):
     p.add_argument("oem", nargs="+", type=Path, help="OEM files of consecutive arcs, in arc order (at least two)")
     p.add_argument("-o", "--out", type=Path, default=Path("overlap"), help="output folder")
-    p.add_argument("--step", type=float, default=600.0, help="comparison grid step (s)")
+    p.add_argument("--step", type=number(), default=600.0, help="comparison grid step (s)")
 
 
 def _labels(paths) -> list[str]:
@@ -31,8 +32,6 @@ def run(args) -> int:
 
     if len(args.oem) < 2:
         raise ValueError(f"odpipe overlap needs at least two OEM files, got {len(args.oem)}")
-    if not args.step > 0:
-        raise ValueError(f"--step {args.step}: must be positive (s)")
     trajs = [oem_trajectory(p) for p in args.oem]
     names = _labels(args.oem)
     overlaps = [compare(a, b, f"{na} - {nb}", args.step)
@@ -43,7 +42,15 @@ def run(args) -> int:
     plot_overlaps(table, args.out / "overlap_position.png", "pos")
     plot_overlaps(table, args.out / "overlap_velocity.png", "vel")
     mean, std = table.iloc[-2], table.iloc[-1]
-    print(f"{len(overlaps)} overlaps; position 3D RMS {mean.pos_3d_rms:.3f} ± {std.pos_3d_rms:.3f} m, "
-          f"velocity 3D RMS {mean.vel_3d_rms * 1e3:.4f} ± {std.vel_3d_rms * 1e3:.4f} mm/s")
+    print(f"{len(overlaps)} overlaps; position 3D RMS {_spread(mean.pos_3d_rms, std.pos_3d_rms)} m, "
+          f"velocity 3D RMS {_spread(mean.vel_3d_rms * 1e3, std.vel_3d_rms * 1e3)} mm/s")
     print(f"table and plots in {args.out}/")
     return Exit.OK
+
+
+def _spread(mean: float, std: float) -> str:
+    """'mean ± std': the mean to 3 significant figures, the standard deviation to the same decimals."""
+    from odpipe.operations.report import significant
+
+    shown = significant(mean)
+    return f"{shown} ± {std:.{len(shown.partition('.')[2])}f}"

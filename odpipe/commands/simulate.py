@@ -4,6 +4,7 @@ from __future__ import annotations
 
 from pathlib import Path
 
+from odpipe.commands._values import number
 from odpipe.errors import Exit
 
 NAME = "simulate"
@@ -13,14 +14,12 @@ HELP = "simulate a tracking case (e.g. runs/artemis_p2_like.toml) into a directo
 def add_arguments(parser) -> None:
     parser.add_argument("case", type=Path, help="case description (TOML; its keys: docs/config.md)")
     parser.add_argument("-o", "--output", type=Path, required=True, help="output directory")
-    parser.add_argument("--days", type=float, help="simulate only the first DAYS of the case")
+    parser.add_argument("--days", type=number(), help="simulate only the first DAYS of the case")
 
 
 def run(args) -> int:
     from odpipe.simulate import run_case
 
-    if args.days is not None and not args.days > 0:
-        raise ValueError(f"--days {args.days}: must be positive")
     paths, truth, obs = run_case(args.case, args.output, days=args.days)
     t = obs.table
     print(f"{len(t)} observables in {t['pass_id'].nunique()} passes, {len(truth.epochs)} maneuvers; files:")

@@ -15,6 +15,7 @@ from __future__ import annotations
 
 import base64
 import html
+import re
 from dataclasses import dataclass, field
 from pathlib import Path
 
@@ -37,6 +38,7 @@ th{background:#eef;white-space:normal;vertical-align:bottom} td.text,th.text{tex
 """
 
 MISSING = "\u2013"  # en dash: a value that is undefined or absent
+NEGATIVE_ZERO = re.compile(r"-0(\.0*)?")   # a negative value that its format rounds to zero
 
 
 def utc_iso(t_tdb, decimals: int = 0):
@@ -80,9 +82,9 @@ def _cell(value, fmt) -> str:
     if isinstance(value, (bool, np.bool_)):
         return "yes" if value else "no"
     if isinstance(value, (float, np.floating, int, np.integer)):
-        if callable(fmt):
-            return fmt(value)
-        return (fmt or ("{:d}" if isinstance(value, (int, np.integer)) else "{:.6g}")).format(value)
+        text = fmt(value) if callable(fmt) else \
+            (fmt or ("{:d}" if isinstance(value, (int, np.integer)) else "{:.6g}")).format(value)
+        return text.lstrip("-") if NEGATIVE_ZERO.fullmatch(text) else text   # -0.04 at 0.1: "0.0", not "-0.0"
     return str(value)
 
 

@@ -131,8 +131,10 @@ def _run(cfg: RunConfig, attempt, log: RunLog, fingerprint: dict) -> dict:
                               rows=fitted_rows(rows, cfg.data.observables))
 
         table = media(table, apriori)
-        log(f"calibrate: media on {int(np.isfinite(table['media_m']).sum())} rows; "
-            f"sources {dict(table['media_source'].value_counts().head(4))}")
+        sources = table["media_source"].value_counts()
+        sources = sources[(sources.index != "") & (sources > 0)].head(4)   # "": rows not corrected
+        log(f"calibrate: media on {int(np.isfinite(table['media_m']).sum())} rows; sources: "
+            + "; ".join(f"{k} ({v} rows)" for k, v in sources.items()))
     else:
         log("calibrate: media corrections off (calibration.media = false)")
 

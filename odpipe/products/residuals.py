@@ -147,7 +147,7 @@ def report_tables(stats: pd.DataFrame) -> list[tuple[str, pd.DataFrame, dict]]:
             t[f"post-fit RMS ({unit})"] = sub["postfit_rms_obs"]
         fmt = {c: significant for c in t.columns if "RMS" in c}
         places = decimals(np.min(sub["postfit_rms"] / np.sqrt(sub["n_used"])) * scale)  # the mean's standard error
-        fmt[f"post-fit mean ({shown})"] = lambda v, p=places: f"{round(v, p) + 0.0:.{p}f}"   # + 0.0: no "-0.00"
+        fmt[f"post-fit mean ({shown})"] = f"{{:.{places}f}}"   # a mean rounded to zero: html_table drops its sign
         out.append((f"{obs}" + (f" (observed in {unit})" if unit else ""), t, fmt))
     return out
 
@@ -176,7 +176,7 @@ COLUMN = {"prefit": "apriori_orbit_los", "postfit": "postfit_los"}  # pre-fit: s
 
 def plot(res: pd.DataFrame, path, which: str = "postfit", title: str = "") -> None:
     """One panel per observable of the ``which`` ("prefit": :func:`apriori_orbit_los`, or "postfit")
-    residuals, stations coloured; edited rows drawn as grey crosses; time axis UTC.
+    residuals, each station in one colour in every panel; edited rows drawn as grey crosses; time axis UTC.
 
     Drawn on a bare Agg figure (no pyplot, no tight layout: fixed margins, one draw per PNG), one marker
     line per station and one for the edited rows."""
@@ -194,6 +194,7 @@ def plot(res: pd.DataFrame, path, which: str = "postfit", title: str = "") -> No
     FigureCanvasAgg(fig)
     fig.subplots_adjust(left=0.09, right=0.955, top=1 - 0.35 / height, bottom=0.75 / height, hspace=0.12)
     axes = fig.subplots(n, 1, sharex=True, squeeze=False)[:, 0]
+    colour: dict = {}   # series -> matplotlib cycle colour, fixed at its first panel
     for ax, obs in zip(axes, observables):
         scale, unit = display_scale(obs)
         sub = res[res["observable"] == obs]
@@ -204,7 +205,7 @@ def plot(res: pd.DataFrame, path, which: str = "postfit", title: str = "") -> No
         for station in sorted(set(stations[~edited])):
             sel = ~edited & (stations == station)
             y = y_all[sel]
-            ax.plot(t_all[sel], y, ".", ms=3,
+            ax.plot(t_all[sel], y, ".", ms=3, color=colour.setdefault(station, f"C{len(colour) % 10}"),
                     label=f"{station} (RMS {significant(np.sqrt(np.mean(y**2)))} {unit})")
         if edited.any():
             ax.plot(t_all[edited], y_all[edited], "x", color="0.6", ms=3,
