@@ -10,7 +10,8 @@ import pandas as pd
 import pytest
 
 from odpipe.preprocess.flags import Flag, summary
-from odpipe.operations.report import decimals, html_table, significant
+from odpipe.numerics.precision import decimals, significant
+from odpipe.operations.report import html_table
 from odpipe.products.residuals import edit_summary, report_tables, series, statistics
 
 

@@ -175,7 +175,7 @@ def test_one_way_prefit_is_the_a_priori_orbit_with_the_fitted_oscillator(run):
     oscillator's zero a priori they would be offset by −c y0 (4.5 m/s), which the report states."""
     from odpipe.constants import C_LIGHT
     from odpipe.measurements import compute, residuals as observed_minus_computed
-    from odpipe.operations.report import significant
+    from odpipe.numerics.precision import significant
 
     tmp, path = run
     res = pd.read_parquet(path / "residuals.parquet")
@@ -208,7 +208,7 @@ def test_one_way_prefit_is_the_a_priori_orbit_with_the_fitted_oscillator(run):
 def test_headline_and_tables_carry_three_significant_figures(run):
     """The headline post-fit RMS and the tables' RMS are the statistics (full precision in the CSV) to 3
     significant figures."""
-    from odpipe.operations.report import significant
+    from odpipe.numerics.precision import significant
 
     _, path = run
     page = html.unescape((path / "report.html").read_text())

@@ -140,7 +140,7 @@ def report_tables(table: pd.DataFrame) -> list[tuple[str, pd.DataFrame, dict]]:
     and the RIC RMS, 3D RMS and 3D maximum differences, position in m and velocity in mm/s, each to 3
     significant figures as the run reports' statistics (GRAIL-B's 566.818 m showed its mm); then the mean
     and standard deviation over the overlaps, without the span columns."""
-    from odpipe.operations.report import significant
+    from odpipe.numerics.precision import significant
     from odpipe.time import tdb_to_utc
 
     each = table[~table["overlap"].isin(["mean", "std"])]

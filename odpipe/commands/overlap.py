@@ -50,7 +50,7 @@ def run(args) -> int:
 
 def _spread(mean: float, std: float) -> str:
     """'mean ± std': the mean to 3 significant figures, the standard deviation to the same decimals."""
-    from odpipe.operations.report import significant
+    from odpipe.numerics.precision import significant
 
     shown = significant(mean)
     return f"{shown} ± {std:.{len(shown.partition('.')[2])}f}"

@@ -45,7 +45,8 @@ from odpipe.products.oem import write_oem
 from odpipe.products.spk import write_spk
 from odpipe.operations import rundir
 from odpipe.operations.schema import ConfigError
-from odpipe.operations.report import Section, significant, write_report
+from odpipe.numerics.precision import significant
+from odpipe.operations.report import Section, write_report
 from odpipe.time import tdb_to_utc
 from odpipe.tracking import ramp_segments
 from parsers.ionex import read_ionex
@@ -333,7 +334,7 @@ def _headline(summary: dict) -> dict:
 
 
 def _three(x) -> float:
-    """An RMS or sigma to the 3 significant figures it carries (:func:`odpipe.operations.report.significant`)."""
+    """An RMS or sigma to the 3 significant figures it carries (:func:`odpipe.numerics.precision.significant`)."""
     return float(significant(x))
 
 

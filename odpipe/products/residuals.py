@@ -15,7 +15,7 @@ import pandas as pd
 from odpipe.constants import C_LIGHT
 from odpipe.measurements import oscillators
 from odpipe.measurements.bands import downlink_bands
-from odpipe.operations.report import decimals, significant
+from odpipe.numerics.precision import decimals, significant
 from parsers.atomic import save_figure
 
 _RATE = ("doppler", "range_rate", "sst_doppler")
