@@ -72,18 +72,23 @@ def _cell(value, fmt) -> str:
     return str(value)
 
 
+def _row_format(fmt, i: int):
+    """Row ``i``'s format of a column: ``fmt`` itself, or its i-th entry when it lists one per row."""
+    return fmt[i] if isinstance(fmt, (list, tuple)) else fmt
+
+
 def html_table(df: pd.DataFrame, formats: dict | None = None) -> str:
     """A DataFrame as an HTML table (no index): ``formats`` maps a column to a format string
-    (e.g. ``"{:.3f}"``) or a callable; other floats get 6 significant figures, NaN an en dash,
-    datetimes ISO seconds; text columns are left aligned."""
+    (e.g. ``"{:.3f}"``), a callable, or a list of those, one per row; other floats get 6 significant
+    figures, NaN an en dash, datetimes ISO seconds; text columns are left aligned."""
     formats = formats or {}
     text = [not (pd.api.types.is_numeric_dtype(df[c]) or pd.api.types.is_datetime64_any_dtype(df[c]))
             or pd.api.types.is_bool_dtype(df[c]) for c in df.columns]
     cls = [" class='text'" if t else "" for t in text]
     head = "".join(f"<th{k}>{html.escape(str(c))}</th>" for c, k in zip(df.columns, cls))
     rows = []
-    for row in df.itertuples(index=False):
-        cells = "".join(f"<td{k}>{html.escape(_cell(v, formats.get(c)))}</td>"
+    for i, row in enumerate(df.itertuples(index=False)):
+        cells = "".join(f"<td{k}>{html.escape(_cell(v, _row_format(formats.get(c), i)))}</td>"
                         for c, v, k in zip(df.columns, row, cls))
         rows.append(f"<tr>{cells}</tr>")
     return f"<div class='scroll'><table><thead><tr>{head}</tr></thead><tbody>{''.join(rows)}</tbody></table></div>"

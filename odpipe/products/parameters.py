@@ -2,11 +2,12 @@
 
 A fit's parameter table has columns ``name``, ``kind``, ``apriori``,
 ``estimate``, ``sigma`` in SI units (:mod:`odpipe.estimation.registry`). For
-a reader they are grouped by unit: positions and biases in m to the mm, angle biases (rad) in deg to
-1e-6 deg,
-velocities in m/s to the µm/s, ΔV in mm/s to the µm/s, maneuver epoch offsets
-in s to the ms, stochastic accelerations in m/s² and drifts in 1/s to 4
-significant figures, scale factors to 1e-5.
+a reader they are grouped by unit: positions and biases in m, angle biases (rad) in deg, velocities
+in m/s, ΔV in mm/s, maneuver epoch offsets in s, scale factors; each row's sigma to 2 significant
+figures and its a priori, estimate and change to the sigma's second digit, never finer than the
+group's resolution (the mm, 1e-6 deg, the µm/s, the µm/s, the ms, 1e-5): a 68-m position sigma
+shows its estimate to the metre. Stochastic accelerations in m/s² and drifts in 1/s keep 4
+significant figures.
 """
 
 from __future__ import annotations
@@ -14,17 +15,19 @@ from __future__ import annotations
 import numpy as np
 import pandas as pd
 
-# (unit, factor from SI, format) of each display group
+from odpipe.numerics.precision import decimals, significant
+
+# (unit, factor from SI, finest decimals shown) of each display group; None: 4 significant figures
 _GROUPS = {
-    "m": ("m", 1.0, "{:.3f}"),
-    "rad": ("deg", 180.0 / np.pi, "{:.6f}"),
-    "m/s": ("m/s", 1.0, "{:.6f}"),
-    "dv": ("mm/s", 1e3, "{:.3f}"),
-    "s": ("s", 1.0, "{:.3f}"),
-    "m/s2": ("m/s²", 1.0, "{:.4g}"),
-    "m/s3": ("m/s³", 1.0, "{:.4g}"),
-    "1/s": ("1/s", 1.0, "{:.4g}"),
-    "1": ("1", 1.0, "{:.5f}"),
+    "m": ("m", 1.0, 3),
+    "rad": ("deg", 180.0 / np.pi, 6),
+    "m/s": ("m/s", 1.0, 6),
+    "dv": ("mm/s", 1e3, 3),
+    "s": ("s", 1.0, 3),
+    "m/s2": ("m/s²", 1.0, None),
+    "m/s3": ("m/s³", 1.0, None),
+    "1/s": ("1/s", 1.0, None),
+    "1": ("1", 1.0, 5),
 }
 _TITLES = {"m": "positions, station coordinates and range biases", "rad": "angle biases", "m/s": "velocities",
            "dv": "maneuver ΔV components", "s": "maneuver epoch offsets and station time-tag offsets", "m/s2": "stochastic and polynomial accelerations",
@@ -72,11 +75,23 @@ def report_tables(params: pd.DataFrame) -> list[tuple[str, pd.DataFrame, dict]]:
         sub = params[[k == key for k in keys]]
         if sub.empty:
             continue
-        unit, factor, fmt = _GROUPS[key]
+        unit, factor, finest = _GROUPS[key]
         change = sub["estimate"] - sub["apriori"]
         t = pd.DataFrame({"parameter": sub["name"], "kind": sub["kind"],
                           f"a priori ({unit})": sub["apriori"] * factor, f"estimate ({unit})": sub["estimate"] * factor,
                           f"estimate − a priori ({unit})": change * factor, f"sigma ({unit})": sub["sigma"] * factor})
-        formats = {c: fmt for c in t.columns[2:]}
+        if finest is None:
+            formats = {c: "{:.4g}" for c in t.columns[2:]}
+        else:   # each row to its sigma's second digit, never finer than the group's resolution
+            rows = [f"{{:.{min(finest, decimals(s / 10)) if np.isfinite(s) and s > 0 else finest}f}}"
+                    for s in t[f"sigma ({unit})"]]
+            formats = {c: rows for c in t.columns[2:5]} | {f"sigma ({unit})": _sigma_format(finest)}
         out.append((f"{_TITLES[key]} ({unit})", t, formats))
     return out
+
+
+def _sigma_format(finest: int):
+    """A sigma to 2 significant figures (a zero or undefined one to ``finest`` decimals)."""
+    def text(value: float) -> str:
+        return significant(value, 2) if np.isfinite(value) and value > 0 else f"{value:.{finest}f}"
+    return text
