@@ -6,8 +6,8 @@ a reader they are grouped by unit: positions and biases in m, angle biases (rad)
 in m/s, ΔV in mm/s, maneuver epoch offsets in s, scale factors; each row's sigma to 2 significant
 figures and its a priori, estimate and change to the sigma's second digit, never finer than the
 group's resolution (the mm, 1e-6 deg, the µm/s, the µm/s, the ms, 1e-5): a 68-m position sigma
-shows its estimate to the metre. Stochastic accelerations in m/s² and drifts in 1/s keep 4
-significant figures.
+shows its estimate to the metre. Stochastic accelerations in m/s², frequency drifts in 1/s and
+fractional frequency offsets keep 4 significant figures.
 """
 
 from __future__ import annotations
@@ -28,11 +28,12 @@ _GROUPS = {
     "m/s3": ("m/s³", 1.0, None),
     "1/s": ("1/s", 1.0, None),
     "1": ("1", 1.0, 5),
+    "y0": ("1", 1.0, None),
 }
 _TITLES = {"m": "positions, station coordinates and range biases", "rad": "angle biases", "m/s": "velocities",
            "dv": "maneuver ΔV components", "s": "maneuver epoch offsets and station time-tag offsets", "m/s2": "stochastic and polynomial accelerations",
            "m/s3": "polynomial acceleration drifts",
-           "1/s": "frequency drifts", "1": "scale factors and fractional offsets"}
+           "1/s": "frequency drifts", "1": "scale factors", "y0": "fractional frequency offsets"}
 
 
 def group(name: str, kind: str) -> str:
@@ -50,7 +51,7 @@ def group(name: str, kind: str) -> str:
     if kind == "stochastic":
         return "m/s2"
     if kind == "clock":
-        return "1/s" if name.endswith("_y1") else "1"
+        return "1/s" if name.endswith("_y1") else "y0"
     if kind == "dynamic" and ".poly[" in name:
         return "m/s3" if name.endswith("1") else "m/s2"
     if kind in ("dynamic", "media"):
@@ -60,7 +61,7 @@ def group(name: str, kind: str) -> str:
 
 def with_units(params: pd.DataFrame) -> pd.DataFrame:
     """The parameter table with a ``unit`` column (SI, as the values are)."""
-    units = {"dv": "m/s", "m/s2": "m/s^2", "m/s3": "m/s^3"}
+    units = {"dv": "m/s", "m/s2": "m/s^2", "m/s3": "m/s^3", "y0": "1"}
     out = params.copy()
     out.insert(2, "unit", [units.get(g, g) for g in map(group, params["name"], params["kind"])])
     return out
@@ -91,7 +92,10 @@ def report_tables(params: pd.DataFrame) -> list[tuple[str, pd.DataFrame, dict]]:
 
 
 def _sigma_format(finest: int):
-    """A sigma to 2 significant figures (a zero or undefined one to ``finest`` decimals)."""
+    """A sigma to 2 significant figures: positional down to 2 decimals past the group's resolution
+    ``finest``, in powers of ten below (a zero or undefined one to ``finest`` decimals)."""
     def text(value: float) -> str:
-        return significant(value, 2) if np.isfinite(value) and value > 0 else f"{value:.{finest}f}"
+        if not (np.isfinite(value) and value > 0):
+            return f"{value:.{finest}f}"
+        return significant(value, 2) if decimals(value / 10) <= finest + 2 else f"{value:.2g}"
     return text
