@@ -98,6 +98,9 @@ def test_next_arc_starts_from_this_arcs_oem(case):
     assert overlaps["pos_3d_rms"].iloc[0] < 100.0  # m: two fits of one truth, each within tens of metres
     stats = pd.read_csv(tmp / "night" / "residual_statistics.csv")
     assert set(stats["arc"]) == {"sim_arc", "sim_arc_next"} and (tmp / "night" / "report.html").is_file()
+    page = (tmp / "night" / "report.html").read_text()   # figures captioned by what they show, not file names
+    assert "Position differences over each overlap: radial, in-track, cross-track and 3D RMS (m)" in page
+    assert "overlap_arcs_pos" not in page
 
 
 def test_python_api_reopens_the_run_as_odpipe_run_wrote_it(case):

@@ -164,7 +164,7 @@ def consecutive_overlaps(trajs: dict, order, out, label: str, title: str = "", s
     """Overlaps of consecutive arcs in ``order`` (names in ``trajs``) whose spans overlap: the
     summary table written to ``out/overlap_{label}.csv`` and its position and velocity plots.
 
-    Returns (table, [png paths]), or (None, []) when no consecutive arcs overlap.
+    Returns (table, [(png path, caption)]), or (None, []) when no consecutive arcs overlap.
     """
     from parsers.atomic import write_text
 
@@ -175,9 +175,11 @@ def consecutive_overlaps(trajs: dict, order, out, label: str, title: str = "", s
     table = summarize([compare(trajs[a], trajs[b], f"{a} - {b}", step) for a, b in pairs])
     write_text(out / f"overlap_{label}.csv", table.to_csv(index=False))
     pngs = []
-    for q in ("pos", "vel"):
-        pngs.append(out / f"overlap_{label}_{q}.png")
-        plot_overlaps(table, pngs[-1], q, f"{title or label} {'position' if q == 'pos' else 'velocity'} overlaps")
+    for q, what, unit in (("pos", "position", "m"), ("vel", "velocity", "mm/s")):
+        pngs.append((out / f"overlap_{label}_{q}.png",
+                     f"{what.capitalize()} differences over each overlap: radial, in-track, cross-track and 3D RMS "
+                     f"({unit})"))
+        plot_overlaps(table, pngs[-1][0], q, f"{title or label} {what} overlaps")
     return table, pngs
 
 

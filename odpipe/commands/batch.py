@@ -109,8 +109,8 @@ def night_report(out: Path, arcs: list[Path], outcomes, overlap_arcs: list[Path]
     if table is not None:
         sec = Section("Overlaps of consecutive arcs (RIC differences, A - B over each overlap)").tables(
             report_tables(table))
-        for png in pngs:
-            sec.figure(png, png.stem)
+        for png, caption in pngs:
+            sec.figure(png, caption)
         sections.append(sec)
         mean, std = table.iloc[-2], table.iloc[-1]
         headline["overlap 3D RMS"] = f"{mean.pos_3d_rms:.1f} ± {std.pos_3d_rms:.1f} m"

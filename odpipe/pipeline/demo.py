@@ -207,8 +207,8 @@ def _report(out: Path, case, plan, files, truth) -> dict:
             continue
         sec = Section(f"{kind.capitalize()}-arc overlaps (RIC differences over each overlap)").tables(
             overlap.report_tables(table))
-        for png in pngs:
-            sec.figure(png, png.stem)
+        for png, caption in pngs:
+            sec.figure(png, caption)
         sections.append(sec)
         summaries[kind] = table
         mean, std = table.iloc[-2], table.iloc[-1]
