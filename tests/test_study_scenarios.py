@@ -127,6 +127,13 @@ def test_a_key_the_scenario_does_not_read_is_refused(tmp_path, name, old, new, k
     assert str(err.value).startswith(f"{path}:{_line(path, key)}: [{key}] "), err.value
 
 
+def test_a_missing_scenario_is_named(tmp_path):
+    path = _copy(tmp_path, "study_halo_geo_crtbp.toml", 'scenario = "halo_geo_crtbp"\n', "")
+    with pytest.raises(ConfigError, match=r"^" + re.escape(f"{path}: [scenario] required key is missing (one of "
+                                                           "halo_geo_crtbp, halo_geo_doppler,")):
+        load_config(path)
+
+
 def test_a_missing_key_is_named(tmp_path):
     path = _copy(tmp_path, "study_halo_geo_crtbp.toml", "seed = 2012\n", "")
     with pytest.raises(ConfigError, match=r"^" + re.escape(f"{path}: [seed] required key is missing") + "$"):

@@ -741,7 +741,9 @@ def load_scenario(path):
     name = next((own["scenario"] for _, _, own in files if "scenario" in own), None)
     if name not in KINDS:
         where = next(((p, text) for p, text, own in files if "scenario" in own), files[0][:2])
-        raise ConfigError(where[0], "scenario", f"must be one of {', '.join(KINDS)}, got {name!r}").located(where[1])
+        reason = f"must be one of {', '.join(KINDS)}, got {name!r}" if name is not None else \
+            f"required key is missing (one of {', '.join(KINDS)})"
+        raise ConfigError(where[0], "scenario", reason).located(where[1])
     cls = KINDS[name]
     merged: dict = {}
     for file, _, own in reversed(files):
