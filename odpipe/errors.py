@@ -26,7 +26,7 @@ MEANING = {
     Exit.INTERNAL: "internal error (a bug: rerun with --debug for the traceback) or a system error",
     Exit.INPUT: "bad input: usage, configuration, a missing, unreadable or malformed file, a bad value",
     Exit.FIT: "the fit failed (diverged, did not converge, or nothing was left to fit)",
-    Exit.PARTIAL: "some arcs of a batch failed (the others ran; see the summary and the night's report)",
+    Exit.PARTIAL: "some arcs of a batch, or some studies, failed (the others ran; see the summary and the report)",
     Exit.INTERRUPTED: "interrupted (Ctrl-C)",
 }
 

@@ -44,6 +44,12 @@ def test_top_level_help_lists_commands_and_exit_statuses(args):
     assert {int(k): v for k, v in rows.items()} == {int(k): v for k, v in MEANING.items()}
 
 
+def test_the_readmes_exit_table_is_the_commands():
+    text = (ROOT / "README.md").read_text()
+    rows = dict(re.findall(r"^\| (\d+) \| (.+) \|$", text.split("| exit | meaning |", 1)[1].split("\n\n", 1)[0], re.M))
+    assert {int(k): v.replace("`", "") for k, v in rows.items()} == {int(k): v for k, v in MEANING.items()}
+
+
 @pytest.mark.parametrize("name", COMMANDS)
 def test_every_command_help(name, capsys):
     with pytest.raises(SystemExit) as done:
