@@ -215,7 +215,7 @@ def test_headline_and_tables_carry_three_significant_figures(run):
     stats = pd.read_csv(path / "residual_statistics.csv")
     for row in stats.itertuples():
         scale, unit = (1e3, "mm/s") if row.observable.startswith("doppler") else (1.0, "m")
-        cell = re.search(rf"postfit RMS {row.observable} {row.station_rx} \({unit}\)</td><td>([^<]*)<", page)
+        cell = re.search(rf"post-fit RMS {row.observable} {row.station_rx} \({unit}\)</td><td>([^<]*)<", page)
         assert float(cell.group(1)) == float(significant(row.postfit_rms * scale))
         assert f"<td>{significant(row.prefit_rms * scale)}</td>" in page
         assert f"<td>{significant(row.postfit_rms * scale)}</td>" in page
