@@ -8,6 +8,7 @@ import pandas as pd
 import pytest
 
 from heo_case import simulate, write_config
+from odpipe.numerics.precision import significant
 from odpipe.pipeline.run import run_config
 from parsers import oem
 from bounds import max_z
@@ -101,6 +102,8 @@ def test_next_arc_starts_from_this_arcs_oem(case):
     page = (tmp / "night" / "report.html").read_text()   # figures captioned by what they show, not file names
     assert "Position differences over each overlap: radial, in-track, cross-track and 3D RMS (m)" in page
     assert "overlap_arcs_pos" not in page
+    mean, std = overlaps["pos_3d_rms"].iloc[-2:]   # the headline at the precision the tables carry
+    assert f"<td>overlap 3D RMS</td><td>{significant(mean)} ± {significant(std)} m</td>" in page
 
 
 def test_python_api_reopens_the_run_as_odpipe_run_wrote_it(case):
