@@ -142,3 +142,19 @@ def test_convert_tdm_between_syntaxes(shared_data, tmp_path):
     a, b = formats.read_any(src).table, formats.read_any(tmp_path / "e2.xml").table
     assert formats.detect(tmp_path / "e2.xml") == "parsers.tdm"
     assert np.array_equal(a["value"], b["value"]) and np.array_equal(a["epoch"], b["epoch"])
+
+
+@pytest.mark.realdata
+def test_inspect_shows_a_tdm_as_a_run_reads_it(shared_data, tmp_path, capsys):
+    """MESSENGER's ODF written as a TDM: inspect counts the same observables, stations and passes as for
+    the ODF (RECEIVE_FREQ_n as DSN Doppler, TRANSMIT_FREQ lines as ramps), and says how many TDM lines
+    the file holds (the 2,228 records and the 169 ramps' frequency and rate lines)."""
+    odf = shared_data / "messenger/odf07155.odf"
+    assert main(["convert", str(odf), "-o", str(tmp_path / "m.tdm")]) == 0
+    capsys.readouterr()
+    from_odf, from_tdm = inspect_lines(capsys, odf), inspect_lines(capsys, tmp_path / "m.tdm")
+    for name in ("observable", "station_tx", "station_rx", "spacecraft", "ramps"):
+        assert field(from_tdm, name) == field(from_odf, name), name
+    assert field(from_odf, "observable") == {"doppler_1way": "23", "doppler_2way": "2053", "doppler_3way": "91",
+                                             "range": "61"}
+    assert any(line.startswith("TDM lines: 2566;") for line in from_tdm)

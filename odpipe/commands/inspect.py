@@ -85,7 +85,16 @@ def summarize(path) -> list[str]:
             lines.append("kinds: " + ", ".join(f"{k} {v}" for k, v in df["kind"].value_counts().items()))
         return lines + report_lines(report)
     data = mod.read(path, errors="report")
-    return [f"format: {name}"] + tracking_summary(data) + report_lines(data.report)
+    note = []
+    if data.meta.get("format") == "TDM":   # summarized as a run reads it: received frequencies as DSN Doppler
+        from odpipe.products.tdm import doppler_from_tdm
+
+        n_lines = len(data.table)
+        data, left = doppler_from_tdm(data)
+        note = [f"TDM lines: {n_lines}; shown as a run reads them: RECEIVE_FREQ_n as DSN Doppler, TRANSMIT_FREQ "
+                f"lines as ramps" + (f", {left} RECEIVE_FREQ rows without a reference left as received frequency"
+                                     if left else "")]
+    return [f"format: {name}"] + note + tracking_summary(data) + report_lines(data.report)
 
 
 def run(args) -> int:
