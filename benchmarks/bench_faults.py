@@ -3,15 +3,15 @@
 A night of ``--arcs`` simulated 6-h arcs (the cislunar HEO of ``tests/heo_case.py`` tracked by three DSN
 sites, Doppler and range; consecutive arcs overlap by 2 h) runs as ``odpipe batch`` on a local Dask
 cluster of two worker processes. Its whole process group (client, nanny and workers) is SIGKILLed after
-a random delay (uniform in ``--min-delay``..``--max-delay`` s, a full night taking about 100 s) and the
-batch is run again, until ``--kills`` kills have hit a running batch. After every kill: each arc
+a random delay (uniform in ``--min-delay``..``--max-delay`` s; by default up to the length of a first
+night run whole, about 10 s on the idle 2-core machine in 2026-11) and the batch is run again, until ``--kills`` kills have hit a running batch. After every kill: each arc
 finished before it is still current with the same manifest, and every ``current`` verifies against its
 manifest's checksums. When a run ends before its kill, the night is complete and checked, and a new
 night starts from the same inputs: every arc and the night's report are complete, every product parses,
 each arc has exactly one complete attempt (no arc fitted twice), every other attempt folder is marked
 abandoned, and no temporary file is left.
 
-Run: ``.venv/bin/python benchmarks/bench_faults.py [--kills 20] [--arcs 6] [--min-delay 5] [--max-delay 100] [--seed 1]
+Run: ``.venv/bin/python benchmarks/bench_faults.py [--kills 20] [--arcs 6] [--min-delay 1] [--max-delay S] [--seed 1]
 [--from-fit]`` (``--from-fit``: the delay counts from the first arc's start instead of the batch's).
 """
 
@@ -174,15 +174,16 @@ def check_night(folder: Path, arcs: int) -> dict:
     return counts
 
 
-def fault_loop(folder: Path, kills: int, arcs: int = 6, min_delay: float = 5.0, max_delay: float = 100.0,
+def fault_loop(folder: Path, kills: int, arcs: int = 6, min_delay: float = 1.0, max_delay: float | None = None,
                seed: int = 1, say=print, from_fit: bool = False) -> dict:
     """Run the batch and SIGKILL it after a random delay until ``kills`` kills have hit a running batch.
 
     The delay counts from the batch's start, or (``from_fit``) from its first arc starting, so that a kill
-    lands among the fits whatever the machine's load makes of the start-up. A run that ends before its kill
-    is a finished night: it is checked (:func:`check_night`) and its outputs removed, and the next run starts
-    a new night from the same inputs; after the last kill the batch runs to the end and that night is checked
-    too."""
+    lands among the fits whatever the machine's load makes of the start-up. Without ``max_delay`` a first
+    night runs whole and the delays are drawn up to its length (measured the same way), so the kills land
+    inside a night on a fast machine and a slow one alike. A run that ends before its kill is a finished
+    night: it is checked (:func:`check_night`) and its outputs removed, and the next run starts a new night
+    from the same inputs; after the last kill the batch runs to the end and that night is checked too."""
     rng = np.random.default_rng(seed)
     batch = write_night(folder, arcs)
     out, night = folder / "out", folder / "night"
@@ -201,6 +202,18 @@ def fault_loop(folder: Path, kills: int, arcs: int = 6, min_delay: float = 5.0, 
         shutil.rmtree(night)
 
     with open(folder / "batch.log", "ab") as log:
+        if max_delay is None:
+            out.mkdir(exist_ok=True)
+            proc, t0 = start_batch(batch, log), time.perf_counter()
+            if from_fit:
+                wait_for_fitting(out, proc)
+            t1 = time.perf_counter()
+            rc = proc.wait()
+            assert rc == 0, f"a batch run failed (rc {rc}); see {folder / 'batch.log'}"
+            max_delay = time.perf_counter() - (t1 if from_fit else t0)
+            night_done(time.perf_counter() - t0)
+            say(f"kills drawn {min_delay:.1f}-{max_delay:.1f} s after the "
+                + ("first arc's start" if from_fit else "batch's start") + ": the first night's length")
         while len(rows) < kills:
             out.mkdir(exist_ok=True)
             before = finished(out)
@@ -245,10 +258,11 @@ def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--kills", type=int, default=20)
     ap.add_argument("--arcs", type=int, default=6)
-    ap.add_argument("--min-delay", type=float, default=5.0,
+    ap.add_argument("--min-delay", type=float, default=1.0,
                     help="s after the batch's start (--from-fit: its first arc's), at the earliest")
-    ap.add_argument("--max-delay", type=float, default=100.0,
-                    help="s after the batch's start (--from-fit: its first arc's), at the latest")
+    ap.add_argument("--max-delay", type=float,
+                    help="s after the batch's start (--from-fit: its first arc's), at the latest (default: the "
+                         "length of a first, whole night)")
     ap.add_argument("--seed", type=int, default=1)
     ap.add_argument("--from-fit", action="store_true", help="count the delay from the first arc's start")
     ap.add_argument("--keep", type=Path, help="work in this folder (kept) instead of a temporary one")
