@@ -74,6 +74,7 @@ def broken_rules(page: str) -> list[str]:
     out += [f"TDB time column: {h!r}" for h in cells.th if "tdb" in h.lower()]
     out += [f"not ISO UTC: {c!r}" for c in cells.td if DATE_LIKE.search(c) and not ISO.match(c)]
     out += [f"negative zero: {c!r}" for c in cells.td if re.fullmatch(r"-0(\.0*)?", c)]
+    out += [f"table without rows: {t[:80]!r}" for t in re.findall(r"<table.*?</table>", page, re.S) if "<td" not in t]
     if not cells.th:
         out.append("no table")
     return out
@@ -83,6 +84,8 @@ def test_the_rules_catch_what_the_old_reports_showed():
     old = ("<table><tr><th>t_start_tdb</th><th>postfit_rms</th></tr>"
            "<tr><td>3.43955e+08</td><td>nan</td></tr><tr><td>2010-11-23 13:00:00</td><td>-0.0</td></tr></table>")
     assert len(broken_rules(old)) == 7
+    # LAGEOS-2's range-only run showed the station diagnostics' headers over no rows
+    assert broken_rules("<table><tr><th>rows</th></tr></table>") == ["table without rows: '<table><tr><th>rows</th></tr></table>'"]
 
 
 def test_a_value_rounded_to_zero_has_no_sign():
@@ -127,6 +130,21 @@ def test_run_report_keeps_the_rules(run):
     for title in ("Residuals per station", "Residuals per pass", "Editing", "Estimated parameters"):
         assert f"<h2>{title}" in page
     assert "class='scroll'" in page  # wide tables scroll inside the page
+
+
+def test_a_range_only_run_report_says_there_is_no_doppler_to_diagnose(run):
+    """An arc without two-way Doppler (LAGEOS-2's, W3B's) has no station diagnostics: the report says so
+    instead of showing the table's headers over no rows."""
+    tmp, _ = run
+    text = (tmp / "arc.toml").read_text().replace('observables = ["doppler_2way", "range", "doppler_1way"]',
+                                                  'observables = ["range"]')
+    (tmp / "range_only.toml").write_text(text.replace('name = "html_arc"', 'name = "html_range_only"')
+                                         .replace("oscillator_sigma = [1e-6, 1e-12]", ""))
+    out = run_config(tmp / "range_only.toml", progress=None)
+    assert out["status"] == "complete"
+    page = (Path(out["run"]) / "report.html").read_text()
+    assert broken_rules(page) == []
+    assert "No two-way Doppler fitted in this arc: nothing to diagnose." in page
 
 
 def test_night_report_keeps_the_rules(run):

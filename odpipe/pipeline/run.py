@@ -297,9 +297,10 @@ def _sections(cfg, res, stats, per_pass, diag, edits, params, figures, findings,
         "(RMS/√n).").tables(residuals.report_tables(stats))
     for png, caption in figures:
         resid.figure(png, caption)
-    sections = [resid, Section("Residuals per pass").tables(residuals.report_tables(per_pass)),
-                Section("Station diagnostics (two-way Doppler)").text(station_diagnostics.summary(diag)).table(
-                    *station_diagnostics.report_table(diag)),
+    diagnostics = Section("Station diagnostics (two-way Doppler)").text(station_diagnostics.summary(diag))
+    if len(diag):
+        diagnostics.table(*station_diagnostics.report_table(diag))
+    sections = [resid, Section("Residuals per pass").tables(residuals.report_tables(per_pass)), diagnostics,
                 Section("Editing").text("Where every row went: the preprocessing editors (a row with two reasons "
                                         "counts in both), then the fit; 'fitted' is the residual tables' used "
                                         "rows.").table(residuals.edit_summary(edits, res)),
