@@ -268,7 +268,8 @@ def _products(cfg, attempt, log, table, arc, edits, fit_seconds, findings, finge
                                ("postfit", "post-fit residuals")):
             png = attempt.product(f"residuals_{which}.png")
             residuals.plot(res, png, which, f"{cfg.run.name}: {caption}")
-            figures.append((png, f"{caption}, along the line of sight"))
+            figures.append((png, f"{caption}, along the line of sight (angles in degrees)"
+                                 if any(res["unit"] == "rad") else f"{caption}, along the line of sight"))
     summary = _summary(cfg, arc, stats, fit_seconds)
     write_text(attempt.product("summary.json"), json.dumps(summary, indent=1, default=float))
     write_text(attempt.product("unlogged_maneuvers.csv"), findings.to_csv(index=False))
@@ -291,7 +292,8 @@ def provenance(cfg, fingerprint: dict, what: str) -> list[str]:
 def _sections(cfg, res, stats, per_pass, diag, edits, params, figures, findings, man_rows, man_stats,
               man_epochs) -> list[Section]:
     resid = Section("Residuals per station").text(
-        "Along the line of sight: Doppler in mm/s, range in m. " + residuals.prefit_note(res) + " Post-fit: "
+        "Along the line of sight: Doppler in mm/s, range in m" + ("; angles in m across it (range × angle), "
+        "in degrees in the plots. " if any(res["unit"] == "rad") else ". ") + residuals.prefit_note(res) + " Post-fit: "
         "against the smoothed solution; the last column is the post-fit RMS in the observable's own unit. "
         "Each RMS to 3 significant figures, each mean to the first digit of its standard error "
         "(RMS/√n).").tables(residuals.report_tables(stats))
