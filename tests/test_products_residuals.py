@@ -173,3 +173,23 @@ def test_angle_residuals_are_plotted_in_degrees(monkeypatch):
     assert az.get_ylabel() == "angle_az (deg)" and rng.get_ylabel() == "range (m)"
     np.testing.assert_allclose(az.get_lines()[0].get_ydata(), angle, rtol=1e-12)
     np.testing.assert_allclose(rng.get_lines()[0].get_ydata(), [2.0, -1.0, 3.0])
+
+
+def test_the_legend_leaves_the_points_visible(monkeypatch):
+    """W3B's pre-fit azimuths: CastleRock's points ran under the legend fixed in the upper right corner; the
+    legend takes the corner with the fewest points under it, here none."""
+    import odpipe.products.residuals as residuals
+
+    saved = []
+    monkeypatch.setattr(residuals, "save_figure", lambda path, fig, **kw: saved.append(fig))
+    t = np.datetime64("2010-11-02T03:00", "ns") + np.arange(120) * np.timedelta64(60, "s")
+    y = np.where(np.arange(120) < 60, 0.0, 1.0)    # the second hour high: under an upper-right legend
+    rows = pd.DataFrame({"station_rx": np.where(np.arange(120) < 60, "Kumsan", "CastleRock"), "observable": "range",
+                         "unit": "m", "epoch": t, "to_los": 1.0, "postfit_los": y, "flags": 0, "status": ""})
+    residuals.plot(rows, "x.png", "postfit")
+    fig = saved[0]
+    fig.canvas.draw()
+    ax = fig.axes[0]
+    box = ax.get_legend().get_window_extent()
+    points = np.vstack([ax.transData.transform(np.column_stack(line.get_data(orig=False))) for line in ax.get_lines()])
+    assert not box.count_contains(points)

@@ -225,7 +225,7 @@ def plot(res: pd.DataFrame, path, which: str = "postfit", title: str = "") -> No
                     ax.set_ylim(-lim, lim)
         ax.set_ylabel(f"{obs} ({unit})")
         ax.grid(alpha=0.3)
-        ax.legend(fontsize=7, loc="upper right", ncol=2)
+        ax.legend(fontsize=7, loc="best", ncol=2)   # the corner with the fewest points under it
     days = date2num(res["epoch"].to_numpy("datetime64[ns]")) if len(res) else np.zeros(1)
     axes[-1].xaxis.set_major_locator(MultipleLocator(_tick_step_days(np.ptp(days))))
     axes[-1].xaxis.set_major_formatter(DateFormatter("%m-%d %H:%M"))
