@@ -318,3 +318,19 @@ def test_overlap_and_maneuver_tables_keep_the_rules():
 def test_utc_iso_of_tdb_seconds():
     assert utc_iso(0.0, 3) == "2000-01-01T11:58:55.816"  # J2000 TDB = 11:58:55.816 UTC (TT-UTC 64.184 s)
     assert utc_iso(np.array([0.0])) == ["2000-01-01T11:58:56"]
+
+
+def test_iterations_per_fit_take_a_line_each_in_the_headline():
+    """LAGEOS-2's five fits (four outward windows and the media refit) made one 230-character headline cell that
+    pushed the headline's values off a 1300-px page; each fit now has its own line in a cell that keeps them."""
+    from odpipe.pipeline.run import _headline
+
+    windows = [["2016-02-13T04:00:00", "2016-02-14T04:00:00"], ["2016-02-12T16:00:00", "2016-02-14T07:40:00"]]
+    stages = [{"fit": "outward window", "iterations": n, "window": w} for n, w in zip((9, 6), windows)]
+    stages.append({"fit": "refit: media along the fitted orbit", "iterations": 6})
+    headline = _headline({"arc": "a", "start": "s", "end": "e", "iterations": 21, "iterations_per_fit": stages})
+    assert headline["iterations per fit"].splitlines() == [
+        "outward window 2016-02-13T04:00:00 .. 2016-02-14T04:00:00: 9",
+        "outward window 2016-02-12T16:00:00 .. 2016-02-14T07:40:00: 6", "refit: media along the fitted orbit: 6"]
+    page = render("t", headline, [])
+    assert ".headline td{white-space:pre-line}" in page and "04:00:00: 9\noutward" in page
