@@ -45,8 +45,10 @@ class _ScaledTroposphere(MediaModel):
         return delay * TROPOSPHERE_SCALE, label
 
 
-def _with_klobuchar(calibrations, ionex):
-    return MediaModel(calibrations, ionex if ionex is not None else KlobucharIonosphere())
+def _with_klobuchar(calibrations, ionex, *args):
+    """The run's media model (its arguments as ``odpipe run`` passes them) with a Klobuchar ionosphere where
+    the run has no IONEX maps."""
+    return MediaModel(calibrations, ionex if ionex is not None else KlobucharIonosphere(), *args)
 
 
 # name -> (config overrides, media model class used by the run or None)

@@ -151,3 +151,45 @@ def test_a_station_has_one_colour_in_every_panel(monkeypatch):
     assert set(colours) == {"DSS-14", "DSS-24", "DSS-27", "DSS-34", "DSS-65"}
     assert all(len(c) == 1 for c in colours.values()), colours
     assert len(set().union(*colours.values())) == 5   # and the stations apart
+
+
+def test_angle_residuals_are_plotted_in_degrees(monkeypatch):
+    """W3B's pre-fit plot drew azimuth and elevation as range x angle in m (up to -200000 at 40,000 km, tick
+    labels running into the axis label); they are plotted in degrees, the unit Orekit's and the config's
+    are in: 0.005 deg at 40,000 km (3.5 km across the line of sight) is drawn as 0.005."""
+    import odpipe.products.residuals as residuals
+
+    saved = []
+    monkeypatch.setattr(residuals, "save_figure", lambda path, fig, **kw: saved.append(fig))
+    rho, angle = 40e6, np.array([0.005, -0.005, 0.01])   # m, deg
+    t = np.datetime64("2010-11-02T14:00", "ns") + np.arange(3) * np.timedelta64(60, "s")
+    rows = pd.concat([
+        pd.DataFrame({"station_rx": "CastleRock", "observable": "angle_az", "unit": "rad", "epoch": t,
+                      "to_los": rho, "postfit_los": rho * np.radians(angle), "flags": 0, "status": ""}),
+        pd.DataFrame({"station_rx": "CastleRock", "observable": "range", "unit": "m", "epoch": t,
+                      "to_los": 1.0, "postfit_los": [2.0, -1.0, 3.0], "flags": 0, "status": ""})], ignore_index=True)
+    residuals.plot(rows, "x.png", "postfit")
+    az, rng = saved[0].axes
+    assert az.get_ylabel() == "angle_az (deg)" and rng.get_ylabel() == "range (m)"
+    np.testing.assert_allclose(az.get_lines()[0].get_ydata(), angle, rtol=1e-12)
+    np.testing.assert_allclose(rng.get_lines()[0].get_ydata(), [2.0, -1.0, 3.0])
+
+
+def test_the_legend_leaves_the_points_visible(monkeypatch):
+    """W3B's pre-fit azimuths: CastleRock's points ran under the legend fixed in the upper right corner; the
+    legend takes the corner with the fewest points under it, here none."""
+    import odpipe.products.residuals as residuals
+
+    saved = []
+    monkeypatch.setattr(residuals, "save_figure", lambda path, fig, **kw: saved.append(fig))
+    t = np.datetime64("2010-11-02T03:00", "ns") + np.arange(120) * np.timedelta64(60, "s")
+    y = np.where(np.arange(120) < 60, 0.0, 1.0)    # the second hour high: under an upper-right legend
+    rows = pd.DataFrame({"station_rx": np.where(np.arange(120) < 60, "Kumsan", "CastleRock"), "observable": "range",
+                         "unit": "m", "epoch": t, "to_los": 1.0, "postfit_los": y, "flags": 0, "status": ""})
+    residuals.plot(rows, "x.png", "postfit")
+    fig = saved[0]
+    fig.canvas.draw()
+    ax = fig.axes[0]
+    box = ax.get_legend().get_window_extent()
+    points = np.vstack([ax.transData.transform(np.column_stack(line.get_data(orig=False))) for line in ax.get_lines()])
+    assert not box.count_contains(points)

@@ -74,6 +74,7 @@ def broken_rules(page: str) -> list[str]:
     out += [f"TDB time column: {h!r}" for h in cells.th if "tdb" in h.lower()]
     out += [f"not ISO UTC: {c!r}" for c in cells.td if DATE_LIKE.search(c) and not ISO.match(c)]
     out += [f"negative zero: {c!r}" for c in cells.td if re.fullmatch(r"-0(\.0*)?", c)]
+    out += [f"table without rows: {t[:80]!r}" for t in re.findall(r"<table.*?</table>", page, re.S) if "<td" not in t]
     if not cells.th:
         out.append("no table")
     return out
@@ -83,6 +84,8 @@ def test_the_rules_catch_what_the_old_reports_showed():
     old = ("<table><tr><th>t_start_tdb</th><th>postfit_rms</th></tr>"
            "<tr><td>3.43955e+08</td><td>nan</td></tr><tr><td>2010-11-23 13:00:00</td><td>-0.0</td></tr></table>")
     assert len(broken_rules(old)) == 7
+    # LAGEOS-2's range-only run showed the station diagnostics' headers over no rows
+    assert broken_rules("<table><tr><th>rows</th></tr></table>") == ["table without rows: '<table><tr><th>rows</th></tr></table>'"]
 
 
 def test_a_value_rounded_to_zero_has_no_sign():
@@ -127,6 +130,21 @@ def test_run_report_keeps_the_rules(run):
     for title in ("Residuals per station", "Residuals per pass", "Editing", "Estimated parameters"):
         assert f"<h2>{title}" in page
     assert "class='scroll'" in page  # wide tables scroll inside the page
+
+
+def test_a_range_only_run_report_says_there_is_no_doppler_to_diagnose(run):
+    """An arc without two-way Doppler (LAGEOS-2's, W3B's) has no station diagnostics: the report says so
+    instead of showing the table's headers over no rows."""
+    tmp, _ = run
+    text = (tmp / "arc.toml").read_text().replace('observables = ["doppler_2way", "range", "doppler_1way"]',
+                                                  'observables = ["range"]')
+    (tmp / "range_only.toml").write_text(text.replace('name = "html_arc"', 'name = "html_range_only"')
+                                         .replace("oscillator_sigma = [1e-6, 1e-12]", ""))
+    out = run_config(tmp / "range_only.toml", progress=None)
+    assert out["status"] == "complete"
+    page = (Path(out["run"]) / "report.html").read_text()
+    assert broken_rules(page) == []
+    assert "No two-way Doppler fitted in this arc: nothing to diagnose." in page
 
 
 def test_night_report_keeps_the_rules(run):
@@ -300,3 +318,19 @@ def test_overlap_and_maneuver_tables_keep_the_rules():
 def test_utc_iso_of_tdb_seconds():
     assert utc_iso(0.0, 3) == "2000-01-01T11:58:55.816"  # J2000 TDB = 11:58:55.816 UTC (TT-UTC 64.184 s)
     assert utc_iso(np.array([0.0])) == ["2000-01-01T11:58:56"]
+
+
+def test_iterations_per_fit_take_a_line_each_in_the_headline():
+    """LAGEOS-2's five fits (four outward windows and the media refit) made one 230-character headline cell that
+    pushed the headline's values off a 1300-px page; each fit now has its own line in a cell that keeps them."""
+    from odpipe.pipeline.run import _headline
+
+    windows = [["2016-02-13T04:00:00", "2016-02-14T04:00:00"], ["2016-02-12T16:00:00", "2016-02-14T07:40:00"]]
+    stages = [{"fit": "outward window", "iterations": n, "window": w} for n, w in zip((9, 6), windows)]
+    stages.append({"fit": "refit: media along the fitted orbit", "iterations": 6})
+    headline = _headline({"arc": "a", "start": "s", "end": "e", "iterations": 21, "iterations_per_fit": stages})
+    assert headline["iterations per fit"].splitlines() == [
+        "outward window 2016-02-13T04:00:00 .. 2016-02-14T04:00:00: 9",
+        "outward window 2016-02-12T16:00:00 .. 2016-02-14T07:40:00: 6", "refit: media along the fitted orbit: 6"]
+    page = render("t", headline, [])
+    assert ".headline td{white-space:pre-line}" in page and "04:00:00: 9\noutward" in page

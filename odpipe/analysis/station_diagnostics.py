@@ -221,7 +221,10 @@ CAUSES = {"timing": "a time-tag offset", "troposphere": "a troposphere (low-elev
 
 def summary(table: pd.DataFrame, factor: float = FACTOR, max_rms: float = MAX_RMS) -> str:
     """One sentence per standing-out station (or that none stands out) for a report, saying which of
-    :func:`diagnose`'s rules (``factor`` times the median, ``max_rms`` in m/s) it exceeds."""
+    :func:`diagnose`'s rules (``factor`` times the median, ``max_rms`` in m/s) it exceeds; an empty table (no
+    two-way Doppler fitted) says so."""
+    if not len(table):
+        return "No two-way Doppler fitted in this arc: nothing to diagnose."
     out = table[table["stands_out"].astype(bool)]
     taken = table[table["likely_cause"].str.endswith("_estimated") & ~table["stands_out"].astype(bool)]
     said = " ".join(f"{r.station}'s residuals were explained by {CAUSES[r.likely_cause]}." for r in taken.itertuples())

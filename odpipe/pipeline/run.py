@@ -268,7 +268,8 @@ def _products(cfg, attempt, log, table, arc, edits, fit_seconds, findings, finge
                                ("postfit", "post-fit residuals")):
             png = attempt.product(f"residuals_{which}.png")
             residuals.plot(res, png, which, f"{cfg.run.name}: {caption}")
-            figures.append((png, f"{caption}, along the line of sight"))
+            figures.append((png, f"{caption}, along the line of sight (angles in degrees)"
+                                 if any(res["unit"] == "rad") else f"{caption}, along the line of sight"))
     summary = _summary(cfg, arc, stats, fit_seconds)
     write_text(attempt.product("summary.json"), json.dumps(summary, indent=1, default=float))
     write_text(attempt.product("unlogged_maneuvers.csv"), findings.to_csv(index=False))
@@ -291,15 +292,17 @@ def provenance(cfg, fingerprint: dict, what: str) -> list[str]:
 def _sections(cfg, res, stats, per_pass, diag, edits, params, figures, findings, man_rows, man_stats,
               man_epochs) -> list[Section]:
     resid = Section("Residuals per station").text(
-        "Along the line of sight: Doppler in mm/s, range in m. " + residuals.prefit_note(res) + " Post-fit: "
+        "Along the line of sight: Doppler in mm/s, range in m" + ("; angles in m across it (range × angle), "
+        "in degrees in the plots. " if any(res["unit"] == "rad") else ". ") + residuals.prefit_note(res) + " Post-fit: "
         "against the smoothed solution; the last column is the post-fit RMS in the observable's own unit. "
         "Each RMS to 3 significant figures, each mean to the first digit of its standard error "
         "(RMS/√n).").tables(residuals.report_tables(stats))
     for png, caption in figures:
         resid.figure(png, caption)
-    sections = [resid, Section("Residuals per pass").tables(residuals.report_tables(per_pass)),
-                Section("Station diagnostics (two-way Doppler)").text(station_diagnostics.summary(diag)).table(
-                    *station_diagnostics.report_table(diag)),
+    diagnostics = Section("Station diagnostics (two-way Doppler)").text(station_diagnostics.summary(diag))
+    if len(diag):
+        diagnostics.table(*station_diagnostics.report_table(diag))
+    sections = [resid, Section("Residuals per pass").tables(residuals.report_tables(per_pass)), diagnostics,
                 Section("Editing").text("Where every row went: the preprocessing editors (a row with two reasons "
                                         "counts in both), then the fit; 'fitted' is the residual tables' used "
                                         "rows.").table(residuals.edit_summary(edits, res)),
@@ -325,12 +328,12 @@ def _sections(cfg, res, stats, per_pass, diag, edits, params, figures, findings,
 
 def _headline(summary: dict) -> dict:
     """The report's headline: the summary with its times and durations labelled, "post-fit" spelt as the
-    report's tables spell it (summary.json keeps its keys)."""
+    report's tables spell it (summary.json keeps its keys), the iterations of each fit on a line of their own."""
     names = {"start": "start (UTC)", "end": "end (UTC)", "fit_seconds": "fit time (s)",
              "iterations": "iterations (all fits)"}
     out = {names.get(k, k.replace("postfit RMS", "post-fit RMS", 1)): v for k, v in summary.items()
            if k != "iterations_per_fit"}
-    out["iterations per fit"] = "; ".join(f"{s['fit']}{' ' + ' .. '.join(s['window']) if 'window' in s else ''}: "
+    out["iterations per fit"] = "\n".join(f"{s['fit']}{' ' + ' .. '.join(s['window']) if 'window' in s else ''}: "
                                           f"{s['iterations']}" for s in summary["iterations_per_fit"])
     return out
 

@@ -4,7 +4,7 @@ Works on a fit's residual table (columns ``epoch``, ``observable``,
 ``station_rx``, ``pass_id``, ``unit``, ``apriori_orbit_los`` (pre-fit: on the
 a priori orbit, see :func:`apriori_orbit_los`), ``postfit_los`` in m or m/s
 along the line of sight, ``postfit`` in the row's unit, ``flags``, ``status``).
-Rate observables are shown in mm/s, range observables in m.
+Rate observables are shown in mm/s, range observables in m; angles in the plots in degrees.
 """
 
 from __future__ import annotations
@@ -174,6 +174,16 @@ def edit_summary(preprocess: pd.DataFrame, res: pd.DataFrame) -> pd.DataFrame:
 COLUMN = {"prefit": "apriori_orbit_los", "postfit": "postfit_los"}  # pre-fit: see apriori_orbit_los
 
 
+def plotted(rows: pd.DataFrame, which: str) -> tuple[np.ndarray, str]:
+    """(values, unit) of one observable's ``which`` residuals as a plot shows them: along the line of sight
+    (:func:`display_scale`), angles (rows in rad) in degrees, their observed unit, not range x angle in m."""
+    los = rows[COLUMN[which]].to_numpy(float)
+    if "unit" in rows and len(rows) and (rows["unit"] == "rad").all():
+        return np.degrees(los / rows["to_los"].to_numpy(float)), "deg"
+    scale, unit = display_scale(str(rows["observable"].iloc[0]) if len(rows) else "")
+    return los * scale, unit
+
+
 def plot(res: pd.DataFrame, path, which: str = "postfit", title: str = "") -> None:
     """One panel per observable of the ``which`` ("prefit": :func:`apriori_orbit_los`, or "postfit")
     residuals, each station in one colour in every panel; edited rows drawn as grey crosses; time axis UTC.
@@ -196,10 +206,9 @@ def plot(res: pd.DataFrame, path, which: str = "postfit", title: str = "") -> No
     axes = fig.subplots(n, 1, sharex=True, squeeze=False)[:, 0]
     colour: dict = {}   # series -> matplotlib cycle colour, fixed at its first panel
     for ax, obs in zip(axes, observables):
-        scale, unit = display_scale(obs)
         sub = res[res["observable"] == obs]
         edited = (sub["flags"] != 0).to_numpy()
-        y_all = sub[COLUMN[which]].to_numpy(float) * scale
+        y_all, unit = plotted(sub, which)
         t_all = date2num(sub["epoch"].to_numpy("datetime64[ns]"))  # days: no unit conversion at each draw
         stations = series(sub, edited)
         for station in sorted(set(stations[~edited])):
@@ -216,7 +225,7 @@ def plot(res: pd.DataFrame, path, which: str = "postfit", title: str = "") -> No
                     ax.set_ylim(-lim, lim)
         ax.set_ylabel(f"{obs} ({unit})")
         ax.grid(alpha=0.3)
-        ax.legend(fontsize=7, loc="upper right", ncol=2)
+        ax.legend(fontsize=7, loc="best", ncol=2)   # the corner with the fewest points under it
     days = date2num(res["epoch"].to_numpy("datetime64[ns]")) if len(res) else np.zeros(1)
     axes[-1].xaxis.set_major_locator(MultipleLocator(_tick_step_days(np.ptp(days))))
     axes[-1].xaxis.set_major_formatter(DateFormatter("%m-%d %H:%M"))
