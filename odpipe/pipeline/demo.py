@@ -13,7 +13,7 @@
    (:mod:`odpipe.simulate.thesis`), in one HTML report.
 
 ``odpipe demo --twin`` runs ``runs/artemis_p2_twin.toml`` instead: the ARTEMIS-P2 twin with the
-thesis' error budget (issue #25), ~10 min on 2 cores against the fast case's ~40 s.
+thesis' error budget (issue #25), 1-3 min on 2 cores against the fast case's ~15 s.
 
 The a priori state of each arc is the truth at its start displaced by 1 km and
 1 cm/s (in operations, the previous arc's prediction); the filter's a priori
