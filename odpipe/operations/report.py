@@ -33,7 +33,7 @@ h3{color:#335;font-size:1em;margin:1em 0 .3em}
 table{border-collapse:collapse;font-size:.78em;margin:.4em 0;font-variant-numeric:tabular-nums}
 td,th{border:1px solid #bbb;padding:.15em .45em;text-align:right;white-space:nowrap}
 th{background:#eef;white-space:normal;vertical-align:bottom} td.text,th.text{text-align:left}
-.headline td:first-child{text-align:left} img{max-width:100%;border:1px solid #ddd;margin:.4em 0}
+.headline td:first-child{text-align:left} .headline td{white-space:pre-line} img{max-width:100%;border:1px solid #ddd;margin:.4em 0}
 .note{color:#555;font-size:.9em}
 """
 
