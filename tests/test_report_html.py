@@ -109,6 +109,16 @@ def test_headline_lists_each_fit_on_its_own_line():
     assert re.search(r"\.headline td\{white-space:pre-line\}", page)   # the page breaks the lines and wraps
 
 
+def test_headline_rms_keeps_its_three_figures():
+    """The twin's long2 headline showed DSS-24's post-fit RMS as 0.12 mm/s (summary.json's float), its tables 0.120."""
+    from odpipe.pipeline.run import _headline
+
+    head = _headline({"postfit RMS doppler_2way DSS-24 (mm/s)": 0.12, "epoch position sigma (m)": 149.0,
+                      "epoch velocity sigma (mm/s)": 0.92, "fit_seconds": 9.76, "iterations_per_fit": []})
+    assert head["post-fit RMS doppler_2way DSS-24 (mm/s)"] == "0.120" and head["epoch position sigma (m)"] == "149"
+    assert head["epoch velocity sigma (mm/s)"] == "0.920" and head["fit time (s)"] == 9.76
+
+
 F_ONE_WAY = 8.4e9            # Hz: an X-band oscillator
 Y0, Y1 = 1.5e-8, 1e-15        # its fractional offset (GRAIL-B's size, 4.5 m/s along the line of sight) and drift (1/s)
 
