@@ -151,3 +151,23 @@ def test_a_station_has_one_colour_in_every_panel(monkeypatch):
     assert set(colours) == {"DSS-14", "DSS-24", "DSS-27", "DSS-34", "DSS-65"}
     assert all(len(c) == 1 for c in colours.values()), colours
     assert len(set().union(*colours.values())) == 5   # and the stations apart
+
+
+@pytest.mark.parametrize("hours, ticks, label", [(14 * 24, "2010-12-01", "time (UTC)"),
+                                                 (10, "11-30 14:00", "time (UTC, 2010)")])
+def test_time_axis_says_the_year(monkeypatch, hours, ticks, label):
+    """The twin's 14-day long2 plots read '12-01 00:00', '12-03 00:00', ...: no year on the axis. Day ticks are
+    ISO dates; hour ticks keep month-day and time with the year in the axis label."""
+    import odpipe.products.residuals as residuals
+
+    saved = []
+    monkeypatch.setattr(residuals, "save_figure", lambda path, fig, **kw: saved.append(fig))
+    epochs = np.datetime64("2010-11-30T13:00", "ns") + np.arange(50) * np.timedelta64(hours * 72, "s")
+    rows = pd.DataFrame({"station_rx": "DSS-24", "observable": "doppler_2way", "band": "S", "epoch": epochs,
+                         "postfit_los": 1e-4, "flags": 0, "status": ""})
+    residuals.plot(rows, "x.png", "postfit")
+    ax = saved[0].axes[-1]
+    saved[0].canvas.draw()
+    shown = [t.get_text() for t in ax.get_xticklabels() if t.get_text()]
+    assert ticks in shown, shown
+    assert ax.get_xlabel() == label
