@@ -28,7 +28,8 @@ def _cell(v) -> str:
 
 
 def markdown_table(df: pd.DataFrame) -> str:
-    """GitHub Markdown table of a DataFrame (floats to 3 significant digits)."""
+    """GitHub Markdown table of a DataFrame (floats to 4 significant digits, trailing zeros dropped; below 1e-3
+    in powers of ten)."""
     lines = ["| " + " | ".join(map(str, df.columns)) + " |",
              "|" + "---|" * len(df.columns)]
     lines += ["| " + " | ".join(_cell(v) for v in row) + " |" for row in df.itertuples(index=False)]
