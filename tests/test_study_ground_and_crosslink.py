@@ -369,3 +369,27 @@ def test_stored_correlation_time_spread_against_the_thesis():
         assert 0.5 < spreads[key]["ratio min"] and spreads[key]["ratio max"] < 2.0, key
     halo_ground = ratios[("ground", "L1", "3s RMS d6-9")]
     assert halo_ground[3.0] < 0.5 < halo_ground[24.0]
+
+
+def test_uncertainty_plot_legend_covers_no_curve(monkeypatch, tmp_path):
+    """uncertainty.png's legend of the nine schedules sat in the GEO panel over the ground-only curves (300-500 m,
+    days 3-9); with more than 4 curves it has a column of its own, inside the figure and clear of every panel."""
+    import numpy as np
+
+    from odpipe.studies import study_report
+
+    saved = []
+    monkeypatch.setattr(study_report, "save_figure", lambda path, fig, **kw: saved.append(fig))
+    t = np.linspace(0.0, 9.0, 50)
+    curves = [(name, 5000.0 * np.exp(-t * (i + 1) / 5.0) + 10.0, {}) for i, name in enumerate(CFG["cases"])]
+    assert len(curves) > 4
+    study_report.plot_convergence(tmp_path, "uncertainty", [{"title": sc, "t_days": t, "curves": curves}
+                                                            for sc in ground.NAMES], "m")
+    from matplotlib.backends.backend_agg import FigureCanvasAgg
+
+    fig = saved[0]
+    renderer = FigureCanvasAgg(fig).get_renderer()   # the figure is closed once saved
+    legend = fig.axes[1].get_legend().get_window_extent(renderer)
+    assert not any(legend.overlaps(ax.get_window_extent(renderer)) for ax in fig.axes)
+    page = fig.bbox
+    assert page.x0 <= legend.x0 and legend.x1 <= page.x1 and page.y0 <= legend.y0 and legend.y1 <= page.y1
