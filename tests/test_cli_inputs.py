@@ -53,6 +53,8 @@ def test_numbers_of_the_other_commands(tmp_path, capsys):
     line = _usage_error(["simulate", str(ROOT / "runs" / "artemis_p2_like.toml"), "-o", str(tmp_path), "--days", "-1"],
                         capsys)
     assert line == "odpipe simulate: error: argument --days: -1.0 must be positive and finite"
+    line = _usage_error(["demo", "-o", str(tmp_path), "--workers", "0"], capsys)   # it waited for ever on no worker
+    assert line == "odpipe demo: error: argument --workers: 0 must be positive and finite"
 
 
 def test_edit_refuses_an_arc_that_ends_before_it_starts(table, tmp_path, capsys):

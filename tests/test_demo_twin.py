@@ -32,6 +32,7 @@ import numpy as np
 import pandas as pd
 import pytest
 
+from odpipe.numerics.precision import significant
 from odpipe.simulate import thesis
 from odpipe.simulate.case import load
 
@@ -72,6 +73,10 @@ def test_comparison_puts_odpipe_beside_the_thesis():
     assert v.loc["short-arc position intrack (m)", "thesis"] == "183 ± 146"
     assert v.loc["short-arc velocity radial (mm/s)", "ratio"] == pytest.approx(2.0)
     assert v.loc["Table 4.4 median Mag. (%)", "ratio"] == pytest.approx(2.0)
+    # odpipe's figures to 3 significant figures with their trailing zeros, as the overlap tables (was '366 ± 10')
+    assert v.loc["short-arc position intrack (m)", "odpipe"] == "366 ± 10.0"
+    assert v.loc["short-arc velocity radial (mm/s)", "odpipe"] == "0.526 ± 0.100"
+    assert v.loc["Table 4.4 median X (%)", "odpipe"] == "2.20"            # 2 x the thesis' 1.1 (was '2.2')
     assert len(v) == 6 + 16
 
 
@@ -145,8 +150,11 @@ def test_twin_12_days_snapshot(twin_dir, twin_truth, monkeypatch):
     # plots, which no figure reads (a fifth of the fits' time)
     with LocalCluster(n_workers=1, threads_per_worker=1, processes=False, dashboard_address=":0") as cluster:
         monkeypatch.setattr(demo, "run_batch", functools.partial(run_batch, scheduler=cluster.scheduler_address))
-        demo.run_demo(twin_dir, 1, progress=lambda *_: None, days=DAYS, case=load(TWIN), plots=False)
+        headline = demo.run_demo(twin_dir, 1, progress=lambda *_: None, days=DAYS, case=load(TWIN), plots=False)
     got = pd.read_csv(twin_dir / "thesis_comparison.csv")
+    # the headline at the precision of the overlap tables (it showed 404.8 ± 568.2 m beside 405 and 568)
+    mean, std = pd.read_csv(twin_dir / "overlap_short.csv").set_index("overlap").loc[["mean", "std"], "pos_3d_rms"]
+    assert headline["short-arc overlap 3D RMS"].startswith(f"{significant(mean)} ± {significant(std)} m, ")
     want = pd.read_csv(FIXTURES / "twin_12d_figures.csv")
     for figure in want["figure"]:
         g, w = _mean(got, figure), _mean(want, figure)

@@ -193,3 +193,23 @@ def test_the_legend_leaves_the_points_visible(monkeypatch):
     box = ax.get_legend().get_window_extent()
     points = np.vstack([ax.transData.transform(np.column_stack(line.get_data(orig=False))) for line in ax.get_lines()])
     assert not box.count_contains(points)
+
+
+@pytest.mark.parametrize("hours, ticks, label", [(14 * 24, "2010-12-01", "time (UTC)"),
+                                                 (10, "11-30 14:00", "time (UTC, 2010)")])
+def test_time_axis_says_the_year(monkeypatch, hours, ticks, label):
+    """The twin's 14-day long2 plots read '12-01 00:00', '12-03 00:00', ...: no year on the axis. Day ticks are
+    ISO dates; hour ticks keep month-day and time with the year in the axis label."""
+    import odpipe.products.residuals as residuals
+
+    saved = []
+    monkeypatch.setattr(residuals, "save_figure", lambda path, fig, **kw: saved.append(fig))
+    epochs = np.datetime64("2010-11-30T13:00", "ns") + np.arange(50) * np.timedelta64(hours * 72, "s")
+    rows = pd.DataFrame({"station_rx": "DSS-24", "observable": "doppler_2way", "band": "S", "epoch": epochs,
+                         "postfit_los": 1e-4, "flags": 0, "status": ""})
+    residuals.plot(rows, "x.png", "postfit")
+    ax = saved[0].axes[-1]
+    saved[0].canvas.draw()
+    shown = [t.get_text() for t in ax.get_xticklabels() if t.get_text()]
+    assert ticks in shown, shown
+    assert ax.get_xlabel() == label

@@ -97,6 +97,31 @@ def test_a_value_rounded_to_zero_has_no_sign():
     assert broken_rules(page) == [] and "<td>-0.1</td>" in page and page.count("<td>0.0</td>") == 3
 
 
+def test_headline_lists_each_fit_on_its_own_line():
+    """The twin's long2 report ran 'iterations per fit' (five fits with their windows) on one line beyond the
+    page's right edge, and the nowrap cells pushed every headline value off the page with it."""
+    from odpipe.pipeline.run import _headline
+
+    fits = [{"fit": "growing arc", "iterations": 2, "window": ["2010-11-30T13:00:00", f"2010-12-0{d}T13:00:00"]}
+            for d in (2, 4, 9)] + [{"fit": "whole arc", "iterations": 2}]
+    line = _headline({"arc": "long2", "iterations_per_fit": fits})["iterations per fit"]
+    assert line.splitlines() == ["growing arc 2010-11-30T13:00:00 .. 2010-12-02T13:00:00: 2",
+                                 "growing arc 2010-11-30T13:00:00 .. 2010-12-04T13:00:00: 2",
+                                 "growing arc 2010-11-30T13:00:00 .. 2010-12-09T13:00:00: 2", "whole arc: 2"]
+    page = render("odpipe run long2", {"iterations per fit": line}, [])
+    assert re.search(r"\.headline td\{white-space:pre-line\}", page)   # the page breaks the lines and wraps
+
+
+def test_headline_rms_keeps_its_three_figures():
+    """The twin's long2 headline showed DSS-24's post-fit RMS as 0.12 mm/s (summary.json's float), its tables 0.120."""
+    from odpipe.pipeline.run import _headline
+
+    head = _headline({"postfit RMS doppler_2way DSS-24 (mm/s)": 0.12, "epoch position sigma (m)": 149.0,
+                      "epoch velocity sigma (mm/s)": 0.92, "fit_seconds": 9.76, "iterations_per_fit": []})
+    assert head["post-fit RMS doppler_2way DSS-24 (mm/s)"] == "0.120" and head["epoch position sigma (m)"] == "149"
+    assert head["epoch velocity sigma (mm/s)"] == "0.920" and head["fit time (s)"] == 9.76
+
+
 F_ONE_WAY = 8.4e9            # Hz: an X-band oscillator
 Y0, Y1 = 1.5e-8, 1e-15        # its fractional offset (GRAIL-B's size, 4.5 m/s along the line of sight) and drift (1/s)
 

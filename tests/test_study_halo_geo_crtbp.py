@@ -76,7 +76,12 @@ def test_postfit_range_rms_against_the_paper():
     assert rms == pytest.approx(POSTFIT_RANGE_RMS_M, rel=1e-4)
 
 
-def test_command_writes_the_report(tmp_path):
+def test_command_writes_the_report(tmp_path, monkeypatch):
+    from odpipe.studies import study_report
+
+    figures = []
+    monkeypatch.setattr(study_report, "save_figure",
+                        lambda path, fig, **kw: (figures.append(fig), path.write_bytes(b"png")))
     text = CONFIG.read_text().replace("arc_days = 9.0", "arc_days = 1.0") \
         .replace("cadence_s = 100.0", "cadence_s = 300.0").replace("compare_day = 8.0", "compare_day = 1.0")
     text = text[:text.index("[[variant]]")] + text[text.index("[montecarlo]"):]
@@ -92,3 +97,7 @@ def test_command_writes_the_report(tmp_path):
     assert chi2.ppf(0.0005, n - 12) < n * rms**2 < chi2.ppf(0.9995, n)
     assert table.loc[table.quantity.str.startswith("post-fit range residual"), "paper"].iloc[0] \
         == CFG["paper"]["postfit_range_rms_m"]
+    # each y label is its panel's unit (convergence.png's position panels said 'error / sigma' over metres)
+    for ax in figures[0].axes:
+        if ax.get_ylabel():
+            assert ax.get_title().endswith(f"({ax.get_ylabel()})"), (ax.get_title(), ax.get_ylabel())

@@ -4,6 +4,7 @@ import logging
 import time
 from pathlib import Path
 
+from odpipe.commands._values import number
 from odpipe.errors import Exit
 
 NAME = "demo"
@@ -14,9 +15,9 @@ _log = logging.getLogger(__name__)
 
 def add_arguments(p):
     p.add_argument("-o", "--out", type=Path, default=Path("out/demo"), help="output folder")
-    p.add_argument("--workers", type=int, default=2, help="local Dask workers")
+    p.add_argument("--workers", type=number(int), default=2, help="local Dask workers")
     p.add_argument("--twin", action="store_true",
-                   help="the ARTEMIS-P2 twin with the thesis' error budget (runs/artemis_p2_twin.toml, ~10 min)")
+                   help="the ARTEMIS-P2 twin with the thesis' error budget (runs/artemis_p2_twin.toml, 1-3 min)")
 
 
 def run(args) -> int:

@@ -328,11 +328,13 @@ def _sections(cfg, res, stats, per_pass, diag, edits, params, figures, findings,
 
 def _headline(summary: dict) -> dict:
     """The report's headline: the summary with its times and durations labelled, "post-fit" spelt as the
-    report's tables spell it (summary.json keeps its keys), the iterations of each fit on a line of their own."""
+    report's tables spell it (summary.json keeps its keys), its RMS and sigmas written to their 3 significant
+    figures (0.120, as the tables, not the float's 0.12), one line per fit of the arc."""
     names = {"start": "start (UTC)", "end": "end (UTC)", "fit_seconds": "fit time (s)",
              "iterations": "iterations (all fits)"}
-    out = {names.get(k, k.replace("postfit RMS", "post-fit RMS", 1)): v for k, v in summary.items()
-           if k != "iterations_per_fit"}
+    out = {names.get(k, k.replace("postfit RMS", "post-fit RMS", 1)):
+           significant(v) if k.startswith(("postfit RMS", "epoch position sigma", "epoch velocity sigma")) else v
+           for k, v in summary.items() if k != "iterations_per_fit"}
     out["iterations per fit"] = "\n".join(f"{s['fit']}{' ' + ' .. '.join(s['window']) if 'window' in s else ''}: "
                                           f"{s['iterations']}" for s in summary["iterations_per_fit"])
     return out

@@ -227,9 +227,12 @@ def plot(res: pd.DataFrame, path, which: str = "postfit", title: str = "") -> No
         ax.grid(alpha=0.3)
         ax.legend(fontsize=7, loc="best", ncol=2)   # the corner with the fewest points under it
     days = date2num(res["epoch"].to_numpy("datetime64[ns]")) if len(res) else np.zeros(1)
-    axes[-1].xaxis.set_major_locator(MultipleLocator(_tick_step_days(np.ptp(days))))
-    axes[-1].xaxis.set_major_formatter(DateFormatter("%m-%d %H:%M"))
-    axes[-1].set_xlabel("time (UTC)")
+    step = _tick_step_days(np.ptp(days))
+    axes[-1].xaxis.set_major_locator(MultipleLocator(step))
+    # ticks on whole days as ISO dates; on hours as month-day and time, the year in the axis label
+    axes[-1].xaxis.set_major_formatter(DateFormatter("%Y-%m-%d" if step >= 1 else "%m-%d %H:%M"))
+    year = str(np.datetime64(res["epoch"].min(), "Y")) if len(res) else ""
+    axes[-1].set_xlabel("time (UTC)" if step >= 1 or not year else f"time (UTC, {year})")
     # y given: the title sits on the axes' top without matplotlib laying out tick labels to look for some there
     axes[0].set_title(title or f"{which.replace('fit', '-fit')} residuals along the line of sight", y=1.0)
     save_figure(path, fig, dpi=100)

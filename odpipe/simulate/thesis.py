@@ -11,6 +11,8 @@ from __future__ import annotations
 import numpy as np
 import pandas as pd
 
+from odpipe.numerics.precision import significant
+
 COMPONENTS = ("radial", "intrack", "crosstrack")
 
 # (mean, std) per component: position m, velocity mm/s
@@ -50,13 +52,14 @@ def comparison(overlaps: dict, maneuvers: pd.DataFrame | None) -> pd.DataFrame:
             for c, (m, s) in zip(COMPONENTS, OVERLAPS[arc][k]):
                 om, os_ = ours[(k, c)]
                 rows.append({"figure": f"{arc}-arc {'position' if k == 'pos' else 'velocity'} {c} ({unit})",
-                             "thesis": f"{m:g} ± {s:g}", "odpipe": f"{om:.3g} ± {os_:.3g}", "ratio": om / m})
+                             "thesis": f"{m:g} ± {s:g}", "odpipe": f"{significant(om)} ± {significant(os_)}",
+                             "ratio": om / m})
     if maneuvers is not None:
         for stat in ("Median", "Average"):
             for col in TABLE_4_4.columns:
                 ours = float(maneuvers.loc[stat, col])
                 rows.append({"figure": f"Table 4.4 {stat.lower()} {col}", "thesis": f"{TABLE_4_4.loc[stat, col]:g}",
-                             "odpipe": f"{ours:.3g}", "ratio": ours / TABLE_4_4.loc[stat, col]})
+                             "odpipe": significant(ours), "ratio": ours / TABLE_4_4.loc[stat, col]})
     out = pd.DataFrame(rows)
     out["ratio"] = out["ratio"].astype(float).replace([np.inf, -np.inf], np.nan)
     return out

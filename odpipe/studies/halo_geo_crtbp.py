@@ -124,7 +124,7 @@ def run(cfg: dict, out, log=print) -> dict:
             if curves_mc is not None:
                 curves.append((f"MC RMS ({n_mc} runs)", rss(curves_mc, c), {"color": "C1"}))
             panels.append({"title": f"{sc} {what} ({unit})", "t_days": t / DAY, "curves": curves})
-    plot_convergence(out, "convergence", panels, "error / sigma")
+    plot_convergence(out, "convergence", panels, "m")   # the left column's unit (positions); titles say each
     sections = [("Paper vs odpipe", write_table(out, "halo_geo_crtbp", table) + "\n![convergence](convergence.png)\n"),
                 ("Run", f"fit converged: {one['converged']} in {one['iterations']} iterations; "
                         f"{pair.epochs.size} epochs of range and range-rate.\n"),

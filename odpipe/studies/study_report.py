@@ -28,7 +28,8 @@ def _cell(v) -> str:
 
 
 def markdown_table(df: pd.DataFrame) -> str:
-    """GitHub Markdown table of a DataFrame (floats to 3 significant digits)."""
+    """GitHub Markdown table of a DataFrame (floats to 4 significant digits, trailing zeros dropped; below 1e-3
+    in powers of ten)."""
     lines = ["| " + " | ".join(map(str, df.columns)) + " |",
              "|" + "---|" * len(df.columns)]
     lines += ["| " + " | ".join(_cell(v) for v in row) + " |" for row in df.itertuples(index=False)]
@@ -50,19 +51,22 @@ def write_markdown(out: Path, title: str, sections: list[tuple[str, str]]) -> Pa
 def plot_convergence(out: Path, name: str, panels: list[dict], ylabel: str, ncols: int = 2) -> Path:
     """One log-scale panel per dict {title, t_days, curves: [(label, values, style)]}, ncols per row;
     a style's 't' overrides the panel's t_days for that curve, a panel's 'xlabel' the default "time (days)".
-    Titles share the panel's width (about 70 characters at 5 in)."""
+    Titles share the panel's width (about 70 characters at 5 in). The legend (of the first row's last panel)
+    sits in that panel, or with more than 4 curves in a column of its own on the right, off the curves."""
     import matplotlib
 
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
 
     nrows = -(-len(panels) // ncols)
-    width, height = 5.0 * ncols, 3.3 * nrows
+    keyed = min(ncols, len(panels)) - 1                       # the panel whose curves the legend names
+    side = 2.2 if len(panels[keyed]["curves"]) > 4 else 0.0   # inches: the legend's own column
+    width, height = 5.0 * ncols + side, 3.3 * nrows
     fig, axes = plt.subplots(nrows, ncols, figsize=(width, height), squeeze=False)
     # fixed margins (inches: y label and ticks 0.8 left, tick labels 0.65 between columns, x label and the next
     # title 0.85 between rows) instead of a tight layout, which draws the whole figure once more before saving
-    fig.subplots_adjust(left=0.8 / width, right=1.0 - 0.15 / width, bottom=0.5 / height, top=1.0 - 0.3 / height,
-                        wspace=0.65 / ((width - 0.95 - 0.65 * (ncols - 1)) / ncols),
+    fig.subplots_adjust(left=0.8 / width, right=1.0 - (0.15 + side) / width, bottom=0.5 / height,
+                        top=1.0 - 0.3 / height, wspace=0.65 / ((width - side - 0.95 - 0.65 * (ncols - 1)) / ncols),
                         hspace=0.85 / ((height - 0.8 - 0.85 * (nrows - 1)) / nrows))
     for ax, p in zip(axes.ravel(), panels):
         for label, y, style in p["curves"]:
@@ -73,7 +77,10 @@ def plot_convergence(out: Path, name: str, panels: list[dict], ylabel: str, ncol
         ax.grid(True, which="both", alpha=0.3)
     for row in axes:
         row[0].set_ylabel(ylabel)
-    axes.ravel()[min(ncols, len(panels)) - 1].legend(fontsize=7)
+    if side:
+        axes.ravel()[keyed].legend(fontsize=7, loc="upper left", bbox_to_anchor=(1.03, 1.0), borderaxespad=0.0)
+    else:
+        axes.ravel()[keyed].legend(fontsize=7)
     for ax in axes.ravel()[len(panels):]:
         ax.set_visible(False)
     path = Path(out) / f"{name}.png"
