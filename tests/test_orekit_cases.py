@@ -119,9 +119,9 @@ def test_lageos2_run_lands_within_a_metre_of_orekits_state(tmp_path, shared_data
     """Orekit: 5 iterations, the state within 0.62 m and 1.4e-4 m/s of the CPF's, range residuals over 95
     points min/max/mean/std -0.756/+0.845/0.0/0.261 m (each checked by Orekit to 0.62 m). odpipe, fitting
     outward from the same a priori (12 h either side, 24 h, 48 h, then the arc; then the media again along
-    that orbit and the arc again), stations displaced by the solid tide as Orekit's: measured 0.60 m and
-    0.15 mm/s from the CPF state, inside its covariance (chi-square 1.2, 3 dof); std 0.205 m, min/max
-    -0.913/+0.632 m (without the tide: 0.47 m, std 0.221 m)."""
+    that orbit and the arc again), stations displaced by the solid tide as Orekit's: measured 2026-11-26
+    0.600 m and 0.134 mm/s from the CPF state, inside its covariance (chi-square 1.20, 3 dof); std 0.203 m,
+    min/max -0.911/+0.638 m (without the tide: 0.470 m, std 0.219 m)."""
     products = _run(_local_config(tmp_path, shared_data, "lageos2_2016_02_14.toml"))
     assert products.summary["converged"]
     x, cov = _state_and_cov(products, "2016-02-13T16:00:00")
