@@ -393,3 +393,24 @@ def test_uncertainty_plot_legend_covers_no_curve(monkeypatch, tmp_path):
     assert not any(legend.overlaps(ax.get_window_extent(renderer)) for ax in fig.axes)
     page = fig.bbox
     assert page.x0 <= legend.x0 and legend.x1 <= page.x1 and page.y0 <= legend.y0 and legend.y1 <= page.y1
+
+
+def test_log_axis_labels_are_plain_numbers(monkeypatch, tmp_path):
+    """schedule_trade's GEO offset panel (1.6-45 m, about a decade) labelled its ticks 2×10⁰ ... 4×10¹; they read
+    2, 3, 4, 6, 10, 20, 30, 40, on the ticks matplotlib labels."""
+    import numpy as np
+
+    from odpipe.studies import study_report
+
+    saved = []
+    monkeypatch.setattr(study_report, "save_figure", lambda path, fig, **kw: saved.append(fig))
+    t = np.arange(0.0, 80.0, 8.0)
+    study_report.plot_convergence(tmp_path, "offset", [{"title": "GEO", "t_days": t,
+                                                        "curves": [("a", np.geomspace(1.6, 45.0, t.size), {})]}], "m")
+    from matplotlib.backends.backend_agg import FigureCanvasAgg
+
+    fig = saved[0]
+    FigureCanvasAgg(fig).draw()
+    ax = fig.axes[0]
+    shown = [t.get_text() for t in ax.get_yticklabels(minor=False) + ax.get_yticklabels(minor=True) if t.get_text()]
+    assert {"2", "10", "40"} <= set(shown) and all(s.replace(".", "").isdigit() for s in shown), shown

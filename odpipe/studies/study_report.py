@@ -72,6 +72,8 @@ def plot_convergence(out: Path, name: str, panels: list[dict], ylabel: str, ncol
         for label, y, style in p["curves"]:
             ax.semilogy(p["t_days"] if "t" not in style else style["t"], y,
                         **{k: v for k, v in style.items() if k != "t"}, label=label)
+        for which in ("major", "minor"):
+            getattr(ax.yaxis, f"set_{which}_formatter")(_plain_log_labels())
         ax.set_title(p["title"], fontsize=9)
         ax.set_xlabel(p.get("xlabel", "time (days)"))
         ax.grid(True, which="both", alpha=0.3)
@@ -87,3 +89,16 @@ def plot_convergence(out: Path, name: str, panels: list[dict], ylabel: str, ncol
     save_figure(path, fig, dpi=110)
     plt.close(fig)
     return path
+
+
+def _plain_log_labels():
+    """A log axis's tick labels as plain numbers (40, 0.5, 1e-05) on the ticks matplotlib labels, instead of
+    its 4×10¹ (a panel spanning less than a decade labels its minor ticks too)."""
+    from matplotlib.ticker import LogFormatterSciNotation
+
+    class Plain(LogFormatterSciNotation):
+        def __call__(self, x, pos=None):
+            return f"{x:g}" if super().__call__(x, pos) else ""
+
+    return Plain(labelOnlyBase=False)
+
