@@ -213,3 +213,29 @@ def test_time_axis_says_the_year(monkeypatch, hours, ticks, label):
     shown = [t.get_text() for t in ax.get_xticklabels() if t.get_text()]
     assert ticks in shown, shown
     assert ax.get_xlabel() == label
+
+
+def test_large_prefit_residuals_are_drawn_in_a_larger_unit(monkeypatch):
+    """The twin's long2 pre-fit Doppler (up to 1.8e6 mm/s) and range (1.2e6 m) were drawn under matplotlib's '1e6'
+    axis multiplier: they are drawn in m/s and km, the legend's RMS in the same unit; a blunder that was edited
+    does not change the unit of the rows kept."""
+    import odpipe.products.residuals as residuals
+
+    saved = []
+    monkeypatch.setattr(residuals, "save_figure", lambda path, fig, **kw: saved.append(fig))
+    t = np.datetime64("2010-12-01T00:00", "ns") + np.arange(4) * np.timedelta64(600, "s")
+    big = pd.concat([
+        pd.DataFrame({"station_rx": "DSS-24", "observable": "doppler_2way", "epoch": t, "to_los": 1.0,
+                      "apriori_orbit_los": [-1800.0, -900.0, 0.0, 300.0], "flags": 0, "status": ""}),   # m/s
+        pd.DataFrame({"station_rx": "DSS-24", "observable": "range", "epoch": t, "to_los": 1.0,
+                      "apriori_orbit_los": [1.2e6, -3e5, 0.0, 5e5], "flags": 0, "status": ""})], ignore_index=True)
+    residuals.plot(big, "x.png", "prefit")
+    dop, rng = saved[0].axes
+    assert dop.get_ylabel() == "doppler_2way (m/s)" and rng.get_ylabel() == "range (km)"
+    np.testing.assert_allclose(dop.get_lines()[0].get_ydata(), [-1800.0, -900.0, 0.0, 300.0])
+    np.testing.assert_allclose(rng.get_lines()[0].get_ydata(), [1200.0, -300.0, 0.0, 500.0])
+    assert "m/s)" in dop.get_lines()[0].get_label() and "km)" in rng.get_lines()[0].get_label()
+    small = pd.DataFrame({"station_rx": "DSS-24", "observable": "doppler_2way", "epoch": t, "to_los": 1.0,
+                          "postfit_los": [1e-4, -2e-4, 50.0, 0.0], "flags": [0, 0, 1, 0], "status": ""})
+    residuals.plot(small, "y.png", "postfit")
+    assert saved[1].axes[0].get_ylabel() == "doppler_2way (mm/s)"   # the 50-m/s blunder is edited

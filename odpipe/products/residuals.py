@@ -174,14 +174,26 @@ def edit_summary(preprocess: pd.DataFrame, res: pd.DataFrame) -> pd.DataFrame:
 COLUMN = {"prefit": "apriori_orbit_los", "postfit": "postfit_los"}  # pre-fit: see apriori_orbit_los
 
 
+_LARGER = {"mm/s": ("m/s", 1e-3), "m/s": ("km/s", 1e-3), "m": ("km", 1e-3)}   # unit -> (next unit, factor)
+
+
 def plotted(rows: pd.DataFrame, which: str) -> tuple[np.ndarray, str]:
     """(values, unit) of one observable's ``which`` residuals as a plot shows them: along the line of sight
-    (:func:`display_scale`), angles (rows in rad) in degrees, their observed unit, not range x angle in m."""
+    (:func:`display_scale`), angles (rows in rad) in degrees, their observed unit, not range x angle in m.
+    While the unedited rows reach 10^4 of the unit, the next larger one (mm/s → m/s → km/s, m → km): a
+    pre-fit misfit of 1.8e6 mm/s is drawn as 1.8 km/s, not under an axis multiplier of 1e6."""
     los = rows[COLUMN[which]].to_numpy(float)
     if "unit" in rows and len(rows) and (rows["unit"] == "rad").all():
         return np.degrees(los / rows["to_los"].to_numpy(float)), "deg"
     scale, unit = display_scale(str(rows["observable"].iloc[0]) if len(rows) else "")
-    return los * scale, unit
+    values = los * scale
+    kept = values[(rows["flags"] == 0).to_numpy()] if "flags" in rows else values
+    kept = np.abs(kept[np.isfinite(kept)])
+    big = float(kept.max()) if kept.size else 0.0
+    while unit in _LARGER and big >= 1e4:
+        unit, factor = _LARGER[unit]
+        values, big = values * factor, big * factor
+    return values, unit
 
 
 def plot(res: pd.DataFrame, path, which: str = "postfit", title: str = "") -> None:
