@@ -56,6 +56,32 @@ def fitted(chain):
 
 @pytest.mark.slow
 @pytest.mark.realdata
+def test_the_odf_written_as_a_tdm_fits_as_the_odf(fitted, shared_data, tmp_path):
+    """CCSDS TDM end to end: the Doppler-only run's ODF through ``odpipe convert -o X.tdm`` (RECEIVE_FREQ_n with
+    the reference frequency as FREQ_OFFSET, the ramps as TRANSMIT_FREQ lines), then the same configuration
+    on the TDM: the same rows used and edited, and the same estimates and sigmas to the last bit."""
+    from odpipe.cli import main
+
+    tdm = tmp_path / "odf07155.tdm"
+    assert main(["convert", str(shared_data / "messenger/odf07155.odf"), "-o", str(tdm)]) == 0
+    text = (RUNS / "messenger_2007_06_04_doppler.toml").read_text()
+    text = re.sub(r'"\.\./\.\./shared/data/messenger/odf07155\.odf"', f'"{tdm}"', text)
+    text = re.sub(r'"\.\./\.\./shared/data/', f'"{shared_data}/', text)
+    text = re.sub(r'^output = "[^"]+"', 'output = "out"', text, flags=re.M)
+    assert str(tdm) in text
+    (tmp_path / "tdm.toml").write_text(text)
+    out = run_config(tmp_path / "tdm.toml", progress=None)
+    odf_out, _ = fitted
+    a = pd.read_csv(Path(odf_out["run"]) / "parameters.csv")
+    b = pd.read_csv(Path(out["run"]) / "parameters.csv")
+    pd.testing.assert_frame_equal(a, b, check_exact=True)
+    ra = pd.read_csv(Path(odf_out["run"]) / "residual_statistics.csv")
+    rb = pd.read_csv(Path(out["run"]) / "residual_statistics.csv")
+    pd.testing.assert_frame_equal(ra, rb, check_exact=True)
+
+
+@pytest.mark.slow
+@pytest.mark.realdata
 def test_doppler_fit_converges_within_its_sigma_per_station_and_pass(fitted):
     out, cfg = fitted
     assert out["status"] == "complete" and out["converged"]
