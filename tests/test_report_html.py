@@ -338,6 +338,7 @@ def test_overlap_and_maneuver_tables_keep_the_rules():
     assert utc_iso(t[0]) in page and "<td>2.00</td>" in page  # the second overlap's position RMS, 3 figures
     assert "<td>2.000</td>" not in page and "<td>1.50</td>" in page   # and their mean
     assert "\u2013" in page  # an undefined percentage shows as a dash
+    assert "<td>1.73</td>" in page   # the statistics to 3 figures as the thesis comparison (SK-1's own row: 1.732)
 
 
 def test_utc_iso_of_tdb_seconds():

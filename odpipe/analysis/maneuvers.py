@@ -13,6 +13,8 @@ from __future__ import annotations
 import numpy as np
 import pandas as pd
 
+from odpipe.numerics.precision import significant
+
 COLUMNS = ["Mag. (mm/s)", "Mag. (%)", "X (mm/s)", "X (%)", "Y (mm/s)", "Y (%)", "Z (mm/s)", "Z (%)"]
 
 
@@ -60,13 +62,14 @@ def evaluate(table: pd.DataFrame) -> tuple[pd.DataFrame, pd.DataFrame]:
 
 
 def report_tables(rows: pd.DataFrame, stats: pd.DataFrame, epochs_utc=None) -> list[tuple[str, pd.DataFrame, dict]]:
-    """(caption, table, formats) of :func:`evaluate`'s rows and summary for a report: mm/s to the µm/s,
-    percentages to 0.01 %; ``epochs_utc`` (datetime64, one per row) adds each maneuver's epoch."""
+    """(caption, table, formats) of :func:`evaluate`'s rows and summary for a report: each maneuver's mm/s to the
+    µm/s and percentages to 0.01 %; the statistics over all maneuvers (median, average, ...) to 3 significant
+    figures, as the demo's comparison with the thesis gives them; ``epochs_utc`` (datetime64, one per row) adds
+    each maneuver's epoch."""
     per = rows.copy()
     if epochs_utc is not None:
         per.insert(1, "epoch (UTC)", np.asarray(epochs_utc, "datetime64[ns]"))
-    formats = {c: "{:.3f}" if "mm/s" in c else "{:.2f}" for c in list(per.columns) + COLUMNS
-               if "mm/s" in c or "%" in c}
+    formats = {c: "{:.3f}" if "mm/s" in c else "{:.2f}" for c in per.columns if "mm/s" in c or "%" in c}
     summary = stats.reset_index().rename(columns={"index": "statistic"})
     return [("per maneuver", per, formats), ("over all maneuvers (a percentage of a zero design is undefined: –)",
-                                             summary, formats)]
+                                             summary, {c: significant for c in COLUMNS})]
