@@ -95,6 +95,8 @@ class StationKeeping:
     every_days: float = checked(positive)  # d between maneuvers
     gap_days: list[float] = checked(positive)  # d from a burn to its x-z crossing, tried in order
     horizon_days: float = checked(positive)  # d, search window past each gap
+    # m/s: a design above it is not flown, the next gap is tried (Newton can converge on a far root); none: any
+    max_dv_m_s: float | None = checked(positive, default=None)
     # navigation errors of the state the burns are designed on (operations design from OD; none: on the truth,
     # and no draws are made)
     nav_sigma_m: float | None = checked(at_least(0.0), default=None)  # m per ICRF axis

@@ -4,7 +4,10 @@ A maneuver at t is the delta-v of least norm that makes the rotating-frame x
 velocity vanish at the first crossing of the x-z plane (y = 0, pulsating
 Earth-Moon frame) later than t + ``gap`` — the classic crossing control that
 removes the unstable component. Gaps are tried in order of preference and the
-first that converges is flown. A crossing soon after the burn gives little
+first that converges is flown, unless its delta-v exceeds ``max_dv``: Newton may
+converge on a far root (a 3.4 m/s design for a 7-day gap in the ARTEMIS twin
+designed on its true state, where a 5-day gap takes 0.42 m/s), which an operations
+team would not fly; the next gap is tried. A crossing soon after the burn gives little
 leverage on the unstable mode: in the ARTEMIS-like case a 3-day gap needs up to
 1.1 m/s a week, a 7-day gap 1-4 cm/s. Solved by Newton steps along the
 finite-difference gradient (steps clipped to ``max_step`` m/s), with the
@@ -45,14 +48,16 @@ def crossing_vx(force_model, state, t: float, gap: float, horizon: float) -> flo
     return float(rot(np.array([tc]))[0, 3])
 
 
-def design_dv(force_model, state, t: float, gaps=(7 * SECONDS_PER_DAY,), horizon: float = 8 * SECONDS_PER_DAY
-              ) -> np.ndarray:
-    """ICRF delta-v (3,) m/s at TDB ``t``: the crossing design of the first of ``gaps`` (s) that converges."""
+def design_dv(force_model, state, t: float, gaps=(7 * SECONDS_PER_DAY,), horizon: float = 8 * SECONDS_PER_DAY,
+              max_dv: float | None = None) -> np.ndarray:
+    """ICRF delta-v (3,) m/s at TDB ``t``: the crossing design of the first of ``gaps`` (s) that converges to at
+    most ``max_dv`` (m/s; None: any)."""
     for gap in gaps:
         dv = _crossing_dv(force_model, state, t, gap, gap + horizon)
-        if dv is not None:
+        if dv is not None and (max_dv is None or np.linalg.norm(dv) <= max_dv):
             return dv
-    raise ValueError(f"no station-keeping solution at t={t:.0f} for gaps {gaps}")
+    raise ValueError(f"no station-keeping solution at t={t:.0f} for gaps {gaps}"
+                     + (f" within {max_dv} m/s" if max_dv is not None else ""))
 
 
 def _crossing_dv(force_model, state, t, gap, horizon, max_step: float = 0.5, iterations: int = 12):

@@ -136,7 +136,7 @@ def simulate_truth(case, ephemeris, rng) -> Truth:
     gaps = tuple(np.asarray(sk.gap_days, float) * SECONDS_PER_DAY)
     horizon = sk.horizon_days * SECONDS_PER_DAY
     x0 = initial_state(case, ephemeris, t0)
-    x0[3:] += design_dv(nominal, x0, t0, gaps, horizon)
+    x0[3:] += design_dv(nominal, x0, t0, gaps, horizon, sk.max_dv_m_s)
     events = sorted([dict(m) for m in case.maneuvers]
                     + [{"name": f"SK-{k + 1}", "epoch": e, "kind": "station-keeping", "dv": None}
                        for k, e in enumerate(case.station_keeping_epochs())], key=lambda m: m["epoch"])
@@ -154,7 +154,7 @@ def simulate_truth(case, ephemeris, rng) -> Truth:
             if sk.nav_sigma_m is not None or sk.nav_sigma_m_s is not None:
                 state = state + np.concatenate([(sk.nav_sigma_m or 0.0) * rng.standard_normal(3),
                                                 (sk.nav_sigma_m_s or 0.0) * rng.standard_normal(3)])
-            m["dv"] = design_dv(nominal, state, t, gaps, horizon)
+            m["dv"] = design_dv(nominal, state, t, gaps, horizon, sk.max_dv_m_s)
         executed.append((t, executed_dv(m["dv"], ex.sigma_magnitude, np.radians(ex.sigma_pointing_deg), rng)[0]))
     fm = flown()
     traj = propagate(x0, t0, t1, fm, with_stm=False)
