@@ -73,7 +73,7 @@ def night_report(out: Path, arcs: list[Path], outcomes, overlap_arcs: list[Path]
     import pandas as pd
 
     from odpipe.analysis.overlap import consecutive_overlaps, oem_trajectory, report_tables
-    from odpipe.numerics.precision import significant
+    from odpipe.numerics.precision import plus_minus
     from odpipe.pipeline.config import load_config
     from odpipe.pipeline.setup import tdb
     from odpipe.products import residuals
@@ -114,7 +114,7 @@ def night_report(out: Path, arcs: list[Path], outcomes, overlap_arcs: list[Path]
             sec.figure(png, caption)
         sections.append(sec)
         mean, std = table.iloc[-2], table.iloc[-1]
-        headline["overlap 3D RMS"] = f"{significant(mean.pos_3d_rms)} ± {significant(std.pos_3d_rms)} m"
+        headline["overlap 3D RMS"] = f"{plus_minus(mean.pos_3d_rms, std.pos_3d_rms)} m"
     failed = [o for o in outcomes if o.status == "failed"]
     if failed:
         sections.append(Section("Failed arcs").table(pd.DataFrame(

@@ -28,6 +28,7 @@ def _labels(paths) -> list[str]:
 
 def run(args) -> int:
     from odpipe.analysis.overlap import compare, oem_trajectory, plot_overlaps, summarize
+    from odpipe.numerics.precision import plus_minus
     from parsers.atomic import write_text
 
     if len(args.oem) < 2:
@@ -42,15 +43,7 @@ def run(args) -> int:
     plot_overlaps(table, args.out / "overlap_position.png", "pos")
     plot_overlaps(table, args.out / "overlap_velocity.png", "vel")
     mean, std = table.iloc[-2], table.iloc[-1]
-    print(f"{len(overlaps)} overlaps; position 3D RMS {_spread(mean.pos_3d_rms, std.pos_3d_rms)} m, "
-          f"velocity 3D RMS {_spread(mean.vel_3d_rms * 1e3, std.vel_3d_rms * 1e3)} mm/s")
+    print(f"{len(overlaps)} overlaps; position 3D RMS {plus_minus(mean.pos_3d_rms, std.pos_3d_rms)} m, "
+          f"velocity 3D RMS {plus_minus(mean.vel_3d_rms * 1e3, std.vel_3d_rms * 1e3)} mm/s")
     print(f"table and plots in {args.out}/")
     return Exit.OK
-
-
-def _spread(mean: float, std: float) -> str:
-    """'mean ± std': the mean to 3 significant figures, the standard deviation to the same decimals."""
-    from odpipe.numerics.precision import significant
-
-    shown = significant(mean)
-    return f"{shown} ± {std:.{len(shown.partition('.')[2])}f}"

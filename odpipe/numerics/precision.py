@@ -20,3 +20,8 @@ def decimals(step: float) -> int:
     """Decimals that show a quantity to its first significant digit of ``step`` (e.g. a standard error):
     0.13 → 1, 0.004 → 3, 25 → 0."""
     return max(0, -int(np.floor(np.log10(step)))) if np.isfinite(step) and step > 0 else 0
+
+
+def plus_minus(mean: float, std: float) -> str:
+    """'mean ± std' of a statistic over arcs or runs, each to 3 significant figures ("355 ± 240")."""
+    return f"{significant(mean)} ± {significant(std)}"

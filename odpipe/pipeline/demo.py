@@ -32,7 +32,7 @@ from odpipe.analysis import maneuvers as maneuver_report
 from odpipe.analysis import overlap
 from odpipe.constants import J2000, SECONDS_PER_DAY
 from odpipe.dynamics.compile_timer import compile_timer
-from odpipe.numerics.precision import significant
+from odpipe.numerics.precision import plus_minus, significant
 from odpipe.pipeline.run import run_config
 from parsers.atomic import write_text
 from odpipe.products.spk import SpkTrajectory
@@ -215,9 +215,8 @@ def _report(out: Path, case, plan, files, truth) -> dict:
         mean, std = table.iloc[-2], table.iloc[-1]
         headline[f"{kind}-arc overlap RIC RMS"] = " / ".join(   # 3 significant figures, as the tables
             significant(mean[f'pos_{c}_rms']) for c in thesis.COMPONENTS) + " m"
-        headline[f"{kind}-arc overlap 3D RMS"] = (f"{significant(mean.pos_3d_rms)} ± {significant(std.pos_3d_rms)} m, "
-                                                 f"{significant(mean.vel_3d_rms * 1e3)} ± "
-                                                 f"{significant(std.vel_3d_rms * 1e3)} mm/s")
+        headline[f"{kind}-arc overlap 3D RMS"] = (f"{plus_minus(mean.pos_3d_rms, std.pos_3d_rms)} m, "
+                                                 f"{plus_minus(mean.vel_3d_rms * 1e3, std.vel_3d_rms * 1e3)} mm/s")
     truth_rows = []
     for n, kind, a, b in done:
         cur = runs / n / "current"

@@ -11,7 +11,7 @@ from __future__ import annotations
 import numpy as np
 import pandas as pd
 
-from odpipe.numerics.precision import significant
+from odpipe.numerics.precision import plus_minus, significant
 
 COMPONENTS = ("radial", "intrack", "crosstrack")
 
@@ -52,7 +52,7 @@ def comparison(overlaps: dict, maneuvers: pd.DataFrame | None) -> pd.DataFrame:
             for c, (m, s) in zip(COMPONENTS, OVERLAPS[arc][k]):
                 om, os_ = ours[(k, c)]
                 rows.append({"figure": f"{arc}-arc {'position' if k == 'pos' else 'velocity'} {c} ({unit})",
-                             "thesis": f"{m:g} ± {s:g}", "odpipe": f"{significant(om)} ± {significant(os_)}",
+                             "thesis": f"{m:g} ± {s:g}", "odpipe": plus_minus(om, os_),
                              "ratio": om / m})
     if maneuvers is not None:
         for stat in ("Median", "Average"):
